@@ -1,0 +1,185 @@
+#include "model/config/strict_yaml.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <map>
+
+namespace mft::config {
+
+struct StrictNode::Impl {
+  YAML::Node node;
+  std::string file;
+  std::string path;  // dotted key path of this mapping, "" at the root
+  std::set<std::string> used;
+  std::map<std::string, std::unique_ptr<StrictNode>> children;
+};
+
+namespace {
+std::string join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+}  // namespace
+
+StrictNode::StrictNode(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+StrictNode::StrictNode(StrictNode&&) noexcept = default;
+StrictNode& StrictNode::operator=(StrictNode&&) noexcept = default;
+StrictNode::~StrictNode() = default;
+
+StrictNode StrictNode::loadString(const std::string& text, const std::string& origin) {
+  auto impl = std::make_unique<Impl>();
+  impl->file = origin;
+  try {
+    impl->node = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(origin + ": not valid YAML: " + e.what());
+  }
+  if (!impl->node.IsMap()) throw ConfigError(origin + ": expected a mapping of keys at the top level");
+  return StrictNode(std::move(impl));
+}
+
+StrictNode StrictNode::loadFile(const std::string& path) {
+  auto impl = std::make_unique<Impl>();
+  impl->file = path;
+  try {
+    impl->node = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path + ": not valid YAML: " + e.what());
+  }
+  if (!impl->node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
+  return StrictNode(std::move(impl));
+}
+
+void StrictNode::fail(const std::string& key, const std::string& message) const {
+  throw ConfigError(impl_->file + ": " + join(impl_->path, key) + ": " + message);
+}
+const std::string& StrictNode::file() const { return impl_->file; }
+const std::string& StrictNode::path() const { return impl_->path; }
+
+bool StrictNode::has(const std::string& key) const { return static_cast<bool>(impl_->node[key]); }
+
+std::vector<std::string> StrictNode::keys() const {
+  std::vector<std::string> k;
+  for (const auto& kv : impl_->node) k.push_back(kv.first.as<std::string>());
+  return k;
+}
+
+StrictNode& StrictNode::child(const std::string& key) {
+  auto it = impl_->children.find(key);
+  if (it != impl_->children.end()) return *it->second;
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsMap()) fail(key, "expected a mapping");
+  impl_->used.insert(key);
+  auto impl = std::make_unique<Impl>();
+  impl->node = n;
+  impl->file = impl_->file;
+  impl->path = join(impl_->path, key);
+  auto& slot = impl_->children[key];
+  slot.reset(new StrictNode(std::move(impl)));
+  return *slot;
+}
+
+double StrictNode::number(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsScalar()) fail(key, "expected a number");
+  impl_->used.insert(key);
+  double v = 0.0;
+  try {
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected a number, got '" + n.Scalar() + "'");
+  }
+  if (!std::isfinite(v)) fail(key, "must be finite");
+  return v;
+}
+
+double StrictNode::positive(const std::string& key) {
+  const double v = number(key);
+  if (!(v > 0.0)) fail(key, "must be > 0 (got " + std::to_string(v) + ")");
+  return v;
+}
+
+double StrictNode::nonNegative(const std::string& key) {
+  const double v = number(key);
+  if (!(v >= 0.0)) fail(key, "must be >= 0 (got " + std::to_string(v) + ")");
+  return v;
+}
+
+double StrictNode::inRange(const std::string& key, double lo, double hi) {
+  const double v = number(key);
+  if (!(v >= lo && v <= hi))
+    fail(key, "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
+  return v;
+}
+
+int StrictNode::integer(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsScalar()) fail(key, "expected an integer");
+  impl_->used.insert(key);
+  try {
+    return n.as<int>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected an integer, got '" + n.Scalar() + "'");
+  }
+}
+
+bool StrictNode::boolean(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsScalar()) fail(key, "expected true or false");
+  impl_->used.insert(key);
+  try {
+    return n.as<bool>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected true or false, got '" + n.Scalar() + "'");
+  }
+}
+
+std::string StrictNode::text(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsScalar()) fail(key, "expected a string");
+  impl_->used.insert(key);
+  return n.Scalar();
+}
+
+std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expected_size) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsSequence()) fail(key, "expected a list of numbers");
+  impl_->used.insert(key);
+  if (expected_size != 0 && n.size() != expected_size)
+    fail(key, "expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(n.size()));
+  std::vector<double> out;
+  out.reserve(n.size());
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    double v = 0.0;
+    try {
+      v = n[i].as<double>();
+    } catch (const YAML::Exception&) {
+      fail(key, "element " + std::to_string(i) + " is not a number");
+    }
+    if (!std::isfinite(v)) fail(key, "element " + std::to_string(i) + " must be finite");
+    out.push_back(v);
+  }
+  return out;
+}
+
+void StrictNode::finish() {
+  std::vector<std::string> unknown;
+  for (const auto& kv : impl_->node) {
+    const auto k = kv.first.as<std::string>();
+    if (!impl_->used.count(k)) unknown.push_back(k);
+  }
+  if (!unknown.empty()) {
+    std::string list;
+    for (const auto& k : unknown) list += (list.empty() ? "" : ", ") + join(impl_->path, k);
+    throw ConfigError(impl_->file + ": unknown key" + (unknown.size() > 1 ? "s " : " ") + list);
+  }
+  for (auto& c : impl_->children) c.second->finish();
+}
+
+}  // namespace mft::config

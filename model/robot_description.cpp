@@ -1,0 +1,148 @@
+#include "model/robot_description.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "model/config/strict_yaml.hpp"
+
+namespace mft::model {
+namespace {
+
+using config::StrictNode;
+
+LinkParams readLink(StrictNode& n, const char* com_key) {
+  LinkParams l;
+  l.length_m = n.positive("length_m");
+  l.mass_kg = n.positive("mass_kg");
+  l.com_from_joint_m = n.number(com_key);
+  l.inertia_kgm2 = n.positive("inertia_kgm2");
+  if (l.com_from_joint_m < 0.0 || l.com_from_joint_m > l.length_m)
+    n.fail(com_key, "must lie on the link, in [0, length_m]");
+  return l;
+}
+
+Interval readInterval(StrictNode& n, const std::string& key) {
+  const auto v = n.fixed<2>(key);
+  if (!(v[0] < v[1])) n.fail(key, "expected [lower, upper] with lower < upper");
+  return {v[0], v[1]};
+}
+
+// FNV-1a over the canonical bytes of every value: stable across formatting and comments.
+struct Hasher {
+  std::uint64_t h = 1469598103934665603ull;
+  void bytes(const void* p, std::size_t n) {
+    const auto* c = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) {
+      h ^= c[i];
+      h *= 1099511628211ull;
+    }
+  }
+  void add(double v) {
+    if (v == 0.0) v = 0.0;  // fold -0.0
+    bytes(&v, sizeof v);
+  }
+  void add(const std::string& s) { bytes(s.data(), s.size()); }
+};
+
+std::uint64_t computeChecksum(const RobotDescription& d) {
+  Hasher h;
+  h.add(d.name);
+  for (double v : {d.gravity_mps2, d.torso_mass_kg, d.torso_com_m[0], d.torso_com_m[1], d.torso_inertia_kgm2,
+                   d.torso_size_m[0], d.torso_size_m[1], d.imu_position_m[0], d.imu_position_m[1], d.hip_spacing_m,
+                   d.foot_radius_m, d.knee_hard_stop_margin_rad, d.friction_coefficient, d.contact_stiffness_Npm,
+                   d.contact_damping_Nspm})
+    h.add(v);
+  for (const LinkParams* l : {&d.thigh, &d.shank})
+    for (double v : {l->length_m, l->mass_kg, l->com_from_joint_m, l->inertia_kgm2}) h.add(v);
+  for (const Interval* i : {&d.rear_hip_rad, &d.fore_hip_rad, &d.rear_knee_rad, &d.fore_knee_rad}) {
+    h.add(i->lo);
+    h.add(i->hi);
+  }
+  const ActuatorParams& a = d.actuator;
+  for (double v : {a.gear_ratio, a.rotor_inertia_kgm2, a.motor_peak_torque_Nm, a.gearbox_efficiency,
+                   a.output_speed_limit_radps, a.sea.spring_stiffness_Nmprad, a.sea.natural_frequency_radps,
+                   a.sea.damping_ratio, a.sea.settling_time_s})
+    h.add(v);
+  return h.h;
+}
+
+RobotDescription read(StrictNode& root) {
+  RobotDescription d;
+  d.source_file = root.file();
+  const int version = root.integer("schema_version");
+  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
+  d.name = root.text("name");
+  d.gravity_mps2 = root.positive("gravity_mps2");
+
+  auto& torso = root.child("torso");
+  d.torso_mass_kg = torso.positive("mass_kg");
+  d.torso_com_m = torso.fixed<2>("com_m");
+  d.torso_inertia_kgm2 = torso.positive("inertia_kgm2");
+  d.torso_size_m = torso.fixed<2>("size_m");
+  if (!(d.torso_size_m[0] > 0.0 && d.torso_size_m[1] > 0.0)) torso.fail("size_m", "both sizes must be > 0");
+  d.imu_position_m = torso.fixed<2>("imu_position_m");
+
+  auto& leg = root.child("leg");
+  d.hip_spacing_m = leg.nonNegative("hip_spacing_m");
+  d.thigh = readLink(leg.child("thigh"), "com_from_hip_m");
+  d.shank = readLink(leg.child("shank"), "com_from_knee_m");
+  d.foot_radius_m = leg.nonNegative("foot_radius_m");
+  if (2.0 * d.shank.length_m <= d.hip_spacing_m)
+    leg.fail("shank.length_m", "two shanks must span the hip spacing for the legs to close");
+
+  auto& lim = root.child("joint_limits");
+  d.rear_hip_rad = readInterval(lim, "rear_hip_rad");
+  d.fore_hip_rad = readInterval(lim, "fore_hip_rad");
+  d.rear_knee_rad = readInterval(lim, "rear_knee_rad");
+  d.fore_knee_rad = readInterval(lim, "fore_knee_rad");
+  if (d.rear_knee_rad.lo < 0.0 || d.rear_knee_rad.hi > M_PI + 1e-12)
+    lim.fail("rear_knee_rad", "the rear knee bends backward: limits must lie in [0, pi]");
+  if (d.fore_knee_rad.lo < -M_PI - 1e-12 || d.fore_knee_rad.hi > 0.0)
+    lim.fail("fore_knee_rad", "the fore knee bends forward: limits must lie in [-pi, 0]");
+  d.knee_hard_stop_margin_rad = lim.inRange("knee_hard_stop_margin_rad", 0.0, 0.5);
+
+  auto& act = root.child("actuator");
+  d.actuator.gear_ratio = act.positive("gear_ratio");
+  d.actuator.rotor_inertia_kgm2 = act.positive("rotor_inertia_kgm2");
+  d.actuator.motor_peak_torque_Nm = act.positive("motor_peak_torque_Nm");
+  d.actuator.gearbox_efficiency = act.number("gearbox_efficiency");
+  if (!(d.actuator.gearbox_efficiency > 0.0 && d.actuator.gearbox_efficiency <= 1.0))
+    act.fail("gearbox_efficiency", "must lie in (0, 1]");
+  d.actuator.output_speed_limit_radps = act.positive("output_speed_limit_radps");
+  auto& sea = act.child("sea");
+  d.actuator.sea.spring_stiffness_Nmprad = sea.positive("spring_stiffness_Nmprad");
+  d.actuator.sea.natural_frequency_radps = sea.positive("natural_frequency_radps");
+  d.actuator.sea.damping_ratio = sea.positive("damping_ratio");
+  d.actuator.sea.settling_time_s = sea.positive("settling_time_s");
+
+  auto& contact = root.child("contact");
+  d.friction_coefficient = contact.positive("friction_coefficient");
+  d.contact_stiffness_Npm = contact.positive("stiffness_Npm");
+  d.contact_damping_Nspm = contact.nonNegative("damping_Nspm");
+
+  root.finish();
+  d.checksum = computeChecksum(d);
+  return d;
+}
+
+}  // namespace
+
+RobotDescription loadRobotDescription(const std::string& path) {
+  auto root = StrictNode::loadFile(path);
+  return read(root);
+}
+
+RobotDescription parseRobotDescription(const std::string& yaml_text, const std::string& origin) {
+  auto root = StrictNode::loadString(yaml_text, origin);
+  return read(root);
+}
+
+std::string checksumHex(std::uint64_t checksum) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016" PRIx64, checksum);
+  return buf;
+}
+
+}  // namespace mft::model

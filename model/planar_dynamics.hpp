@@ -1,0 +1,107 @@
+#pragma once
+// Planar floating-base rigid-body dynamics of the biped (RBDL style: a model is plain data plus free
+// functions). Planar spatial algebra with 3-vectors (angular, x, z). The floating base is the chain
+// prismatic-x, prismatic-z, revolute-pitch (massless intermediate bodies), so qd = d/dt q exactly and the
+// tree has 11 one-degree-of-freedom joints. Each leg is a tree (two thigh-shank chains from the torso);
+// the loop closure at the foot is the holonomic constraint J_h (rear shank end - fore shank end = 0).
+//
+// Body frames: a link's origin is its proximal joint and the link lies along its local -z axis, so a link at
+// absolute CCW angle a points along (sin a, -cos a). The torso frame is the base frame (origin on the hip axis).
+#include <Eigen/Core>
+#include <vector>
+
+#include "model/coordinates.hpp"
+#include "model/robot_description.hpp"
+
+namespace mft::model {
+
+enum class JointType { PrismaticX, PrismaticZ, Revolute };
+
+struct PlanarBody {
+  int parent = -1;                  // index of the parent body, -1 = world
+  JointType joint = JointType::Revolute;
+  Eigen::Vector2d joint_offset{0, 0};  // joint position in the parent body frame
+  double mass = 0.0;
+  Eigen::Vector2d com{0, 0};        // in the body frame
+  double inertia = 0.0;             // about the CoM
+};
+
+// Body indices in the tree: body i is moved by joint (generalized coordinate) i.
+struct PlanarModel {
+  std::vector<PlanarBody> bodies;   // kNq bodies; bodies 0 and 1 are massless base carriages
+  double gravity = 9.81;
+  double shank_length = 0.0;
+  // The foot of each leg is the distal end of its rear shank (the contact point), and the closure compares
+  // it with the distal end of the fore shank.
+  int rearShankBody(int leg) const { return kneeRearIndex(leg); }
+  int foreShankBody(int leg) const { return kneeForeIndex(leg); }
+  Eigen::Vector2d shankTip() const { return {0.0, -shank_length}; }
+};
+
+PlanarModel buildBipedModel(const RobotDescription& d);
+
+// Everything one control tick needs, preallocated: updateModel fills it without allocating.
+struct ModelData {
+  MatrixQ M = MatrixQ::Zero();       // mass matrix
+  VectorQ h = VectorQ::Zero();       // bias forces: Coriolis, centrifugal and gravity (M qdd + h = S_a' tau + ...)
+  MatrixCQ Jc = MatrixCQ::Zero();    // foot contact Jacobian [right x, right z, left x, left z]
+  VectorC Jc_dot_qd = VectorC::Zero();
+  MatrixHQ Jh = MatrixHQ::Zero();    // loop closure Jacobian (rear tip - fore tip) [right x, z, left x, z]
+  VectorH Jh_dot_qd = VectorH::Zero();
+  VectorC foot_pos = VectorC::Zero();   // world [x, z] of the right foot, then the left
+  VectorC foot_vel = VectorC::Zero();
+  VectorH closure_error = VectorH::Zero();  // rear tip - fore tip, should be ~0
+  Eigen::Vector2d com{0, 0}, com_vel{0, 0};
+  Eigen::Matrix<double, 2, kNq> Jcom = Eigen::Matrix<double, 2, kNq>::Zero();
+  Eigen::Vector2d Jcom_dot_qd{0, 0};
+  // Workspace of the recursive algorithms (sized by kNq, never reallocated).
+  std::array<Eigen::Matrix3d, kNq> X_up{};          // parent-to-body planar transforms
+  std::array<Eigen::Vector3d, kNq> v{}, a{}, f{};   // body velocities, bias accelerations, forces
+  std::array<Eigen::Matrix3d, kNq> Ic{};            // composite inertias
+  std::array<Eigen::Vector3d, kNq> S{};             // joint motion subspaces
+  std::array<Eigen::Matrix3d, kNq> X_base{};        // world-to-body transforms
+};
+
+// Fills every field of ModelData at (q, qd): the full per-tick model update. Allocation-free.
+void updateModel(const PlanarModel& model, const VectorQ& q, const VectorQ& qd, ModelData* data);
+
+// Pieces of updateModel, usable on their own.
+void massMatrix(const PlanarModel& model, const VectorQ& q, ModelData* data);              // CRBA -> data->M
+void biasForces(const PlanarModel& model, const VectorQ& q, const VectorQ& qd, ModelData* data);  // RNEA qdd = 0 -> data->h
+// World position, Jacobian and Jdot*qd of a point fixed in a body (body frame coordinates).
+Eigen::Vector2d pointPosition(const PlanarModel& model, const VectorQ& q, int body, const Eigen::Vector2d& point);
+void pointJacobian(const PlanarModel& model, const VectorQ& q, int body, const Eigen::Vector2d& point,
+                   Eigen::Matrix<double, 2, kNq>* J);
+Eigen::Vector2d pointJdotQd(const PlanarModel& model, const VectorQ& q, const VectorQ& qd, int body,
+                            const Eigen::Vector2d& point);
+// World (x, z, angle) of a body frame.
+Eigen::Vector3d bodyPose(const PlanarModel& model, const VectorQ& q, int body);
+
+// Energies (for tests and the simulator's checks).
+double kineticEnergy(const ModelData& data, const VectorQ& qd);
+double potentialEnergy(const PlanarModel& model, const VectorQ& q);
+
+// Paper eq. 1: constrained forward dynamics with the loop closure. Given actuated torques and contact forces,
+// returns qdd and the closure forces f_h with  M qdd - Jh' f_h = S_a' tau + Jc' f_c - h,  Jh qdd = -Jdot_h qd.
+void constrainedForwardDynamics(const ModelData& data, const VectorA& tau, const VectorC& f_c, VectorQ* qdd,
+                                VectorH* f_h);
+
+// Paper eq. 2-7 helpers. Lambda_h = (Jh M^-1 Jh')^-1, N_h = I - M^-1 Jh' Lambda_h Jh.
+struct ClosureProjection {
+  Eigen::Matrix<double, kNh, kNh> Lambda_h;
+  MatrixQ N_h;
+  MatrixQ Minv;
+};
+void closureProjection(const ModelData& data, ClosureProjection* out);
+
+// Paper eq. 7: actuated torques realising qdd with contact forces f_c.
+VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
+                                const VectorQ& qd, const VectorC& f_c);
+
+// A configuration with both loops closed exactly: base at (x, z, pitch), each foot at the given offset from the
+// hip axis in the base frame (x forward, z up; e.g. (0, -0.40) is straight below). Throws std::invalid_argument
+// if a foot is out of reach. Optionally fills qd consistent with the closure (zero here: a standing pose).
+VectorQ closedLoopConfiguration(const RobotDescription& d, const Eigen::Vector3d& base_pose,
+                                const Eigen::Vector2d& right_foot_in_base, const Eigen::Vector2d& left_foot_in_base);
+
+}  // namespace mft::model

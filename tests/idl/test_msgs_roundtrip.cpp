@@ -1,0 +1,77 @@
+// The generated topic types: bounded (fixed size, no type objects), and every field survives a CDR round trip.
+#include <gtest/gtest.h>
+
+#include "MftMsgs.h"
+#include "MftMsgsPubSubTypes.h"
+
+namespace {
+template <class Msg, class PubSub>
+Msg roundTrip(const Msg& in) {
+  PubSub type;
+  EXPECT_TRUE(type.is_bounded());
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(type.m_typeSize);
+  EXPECT_TRUE(type.serialize(const_cast<Msg*>(&in), &payload));
+  EXPECT_LE(payload.length, type.m_typeSize);
+  Msg out;
+  EXPECT_TRUE(type.deserialize(&payload, &out));
+  return out;
+}
+}  // namespace
+
+TEST(Msgs, SensorDataRoundTrip) {
+  mft::msg::SensorData m;
+  m.tick(123456789012ull);
+  m.stamp_ns(987654321ull);
+  for (int i = 0; i < 4; ++i) {
+    m.actuated_pos()[i] = 0.1 * i - 0.7;
+    m.passive_vel()[i] = -3.25 * i;
+    m.sea_torque()[i] = 52.36 - i;
+  }
+  m.gyro_pitch_rate(-0.125);
+  m.accel()[1] = 9.81;
+  m.contact()[0] = true;
+  const auto out = roundTrip<mft::msg::SensorData, mft::msg::SensorDataPubSubType>(m);
+  EXPECT_TRUE(out == m);
+  EXPECT_EQ(out.tick(), 123456789012ull);
+  EXPECT_DOUBLE_EQ(out.sea_torque()[3], 49.36);
+  EXPECT_TRUE(out.contact()[0]);
+  EXPECT_FALSE(out.contact()[1]);
+}
+
+TEST(Msgs, JointCommandRoundTrip) {
+  mft::msg::JointCommand m;
+  m.tick(42);
+  m.seq(43);
+  m.tau({1.5, -2.5, 3.5, -4.5});
+  m.mode(mft::msg::COMMAND_MODE_DAMPING);
+  const auto out = roundTrip<mft::msg::JointCommand, mft::msg::JointCommandPubSubType>(m);
+  EXPECT_TRUE(out == m);
+  EXPECT_EQ(out.mode(), mft::msg::COMMAND_MODE_DAMPING);
+}
+
+TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
+  mft::msg::GroundTruth gt;
+  gt.q()[10] = 1.25;
+  gt.lti()[1] = 0.7;
+  EXPECT_TRUE((roundTrip<mft::msg::GroundTruth, mft::msg::GroundTruthPubSubType>(gt) == gt));
+  mft::msg::RobotState rs;
+  rs.qd()[2] = -0.5;
+  rs.contact()[1] = true;
+  EXPECT_TRUE((roundTrip<mft::msg::RobotState, mft::msg::RobotStatePubSubType>(rs) == rs));
+  mft::msg::OperatorCommand oc;
+  oc.z_cmd(0.42);
+  oc.mode(mft::msg::LOCOMOTION_WALK);
+  EXPECT_TRUE((roundTrip<mft::msg::OperatorCommand, mft::msg::OperatorCommandPubSubType>(oc) == oc));
+  mft::msg::Reference ref;
+  ref.stance_leg(-1);
+  ref.foot_acc()[3] = 7.0;
+  EXPECT_TRUE((roundTrip<mft::msg::Reference, mft::msg::ReferencePubSubType>(ref) == ref));
+  mft::msg::WbcDiagnostics d;
+  d.status(3);
+  d.task_error()[5] = 1e-3;
+  EXPECT_TRUE((roundTrip<mft::msg::WbcDiagnostics, mft::msg::WbcDiagnosticsPubSubType>(d) == d));
+  mft::msg::Disturbance dist;
+  dist.impulse_Ns(7.1);
+  dist.trigger(mft::msg::TRIGGER_AT_NEXT_LIFTOFF);
+  EXPECT_TRUE((roundTrip<mft::msg::Disturbance, mft::msg::DisturbancePubSubType>(dist) == dist));
+}

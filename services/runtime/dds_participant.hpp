@@ -1,0 +1,53 @@
+#pragma once
+// The DDS side of every mft-wbc service: one participant built from the project's QoS profile file
+// (config/dds_profiles.xml), loopback UDP only, and typed topic writers/readers created from named profiles.
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace mft::services {
+
+class DdsError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Highest domain id usable with the default UDP port mapping of Fast DDS (PB 7400 + DG 250 * domain < 65536).
+constexpr int kMaxDomainId = 232;
+
+// Validates a domain id, throwing DdsError with a message that names the valid range.
+int checkedDomainId(long domain_id);
+
+class DdsParticipant {
+ public:
+  // Loads `profiles_file` (throws if it is missing or malformed) and creates a participant with the
+  // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery.
+  DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name);
+  ~DdsParticipant();
+  DdsParticipant(const DdsParticipant&) = delete;
+  DdsParticipant& operator=(const DdsParticipant&) = delete;
+
+  // Registers the type on first use and returns the topic (one per name).
+  eprosima::fastdds::dds::Topic* topic(const std::string& topic_name, eprosima::fastdds::dds::TopicDataType* type);
+
+  eprosima::fastdds::dds::DomainParticipant* get() const { return participant_; }
+  eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
+  eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
+  int domainId() const { return domain_id_; }
+
+ private:
+  int domain_id_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  std::map<std::string, eprosima::fastdds::dds::TypeSupport> types_;
+};
+
+}  // namespace mft::services

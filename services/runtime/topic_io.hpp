@@ -1,0 +1,119 @@
+#pragma once
+// Typed topic writers and readers on a DdsParticipant, created from a named QoS profile.
+// The reader delivers every valid sample to a callback on the DDS receive thread (the cheapest path at
+// 1 kHz, DDS.md section 1) and counts deadline misses, liveliness changes and matched writers.
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <thread>
+
+#include "services/runtime/dds_participant.hpp"
+
+namespace mft::services {
+
+template <class Msg, class PubSubType>
+class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
+ public:
+  TopicWriter(DdsParticipant& p, const std::string& topic_name, const std::string& profile) {
+    auto* topic = p.topic(topic_name, new PubSubType());
+    writer_ = p.publisher()->create_datawriter_with_profile(topic, profile, this);
+    if (!writer_) throw DdsError("cannot create a writer on " + topic_name + " with profile " + profile);
+    publisher_ = p.publisher();
+  }
+  ~TopicWriter() override {
+    if (writer_) publisher_->delete_datawriter(writer_);
+  }
+  TopicWriter(const TopicWriter&) = delete;
+  TopicWriter& operator=(const TopicWriter&) = delete;
+
+  bool write(const Msg& msg) { return writer_->write(const_cast<Msg*>(&msg)); }
+  int matched() const { return matched_.load(); }
+  std::uint64_t offeredDeadlineMisses() const { return offered_deadline_misses_.load(); }
+
+  void on_publication_matched(eprosima::fastdds::dds::DataWriter*,
+                              const eprosima::fastdds::dds::PublicationMatchedStatus& s) override {
+    matched_ = s.current_count;
+  }
+  void on_offered_deadline_missed(eprosima::fastdds::dds::DataWriter*,
+                                  const eprosima::fastdds::dds::OfferedDeadlineMissedStatus&) override {
+    ++offered_deadline_misses_;
+  }
+
+ private:
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+  std::atomic<int> matched_{0};
+  std::atomic<std::uint64_t> offered_deadline_misses_{0};
+};
+
+template <class Msg, class PubSubType>
+class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
+ public:
+  using Callback = std::function<void(const Msg&)>;
+  TopicReader(DdsParticipant& p, const std::string& topic_name, const std::string& profile, Callback on_sample)
+      : on_sample_(std::move(on_sample)) {
+    auto* topic = p.topic(topic_name, new PubSubType());
+    subscriber_ = p.subscriber();
+    reader_ = subscriber_->create_datareader_with_profile(topic, profile, this);
+    if (!reader_) throw DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
+  }
+  ~TopicReader() override {
+    if (reader_) subscriber_->delete_datareader(reader_);
+  }
+  TopicReader(const TopicReader&) = delete;
+  TopicReader& operator=(const TopicReader&) = delete;
+
+  int matched() const { return matched_.load(); }
+  std::uint64_t received() const { return received_.load(); }
+  std::uint64_t requestedDeadlineMisses() const { return requested_deadline_misses_.load(); }
+  int aliveWriters() const { return alive_writers_.load(); }
+
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++received_;
+      if (on_sample_) on_sample_(sample_);
+    }
+  }
+  void on_subscription_matched(eprosima::fastdds::dds::DataReader*,
+                               const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
+    matched_ = s.current_count;
+  }
+  void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
+                                    const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
+    ++requested_deadline_misses_;
+  }
+  void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
+                             const eprosima::fastdds::dds::LivelinessChangedStatus& s) override {
+    alive_writers_ = s.alive_count;
+  }
+
+ private:
+  Callback on_sample_;
+  Msg sample_;  // persistent: never construct a message per cycle
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  std::atomic<int> matched_{0};
+  std::atomic<int> alive_writers_{0};
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> requested_deadline_misses_{0};
+};
+
+// Waits until `ready()` holds or the timeout passes; returns whether it held.
+inline bool waitUntil(const std::function<bool()>& ready, std::chrono::milliseconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!ready()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+}  // namespace mft::services

@@ -80,6 +80,30 @@ StrictNode& StrictNode::child(const std::string& key) {
   return *slot;
 }
 
+std::size_t StrictNode::listSize(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsSequence()) fail(key, "expected a list");
+  impl_->used.insert(key);
+  return n.size();
+}
+
+StrictNode& StrictNode::item(const std::string& key, std::size_t index) {
+  const std::string name = key + "[" + std::to_string(index) + "]";
+  auto it = impl_->children.find(name);
+  if (it != impl_->children.end()) return *it->second;
+  if (index >= listSize(key)) fail(name, "no such list element");
+  const YAML::Node n = impl_->node[key][index];
+  if (!n.IsMap()) fail(name, "expected a mapping");
+  auto impl = std::make_unique<Impl>();
+  impl->node = n;
+  impl->file = impl_->file;
+  impl->path = join(impl_->path, name);
+  auto& slot = impl_->children[name];
+  slot.reset(new StrictNode(std::move(impl)));
+  return *slot;
+}
+
 double StrictNode::number(const std::string& key) {
   const YAML::Node n = impl_->node[key];
   if (!n) fail(key, "missing key");

@@ -36,6 +36,10 @@ class StrictNode {
 
   bool has(const std::string& key) const;
   StrictNode& child(const std::string& key);
+  // Lists of mappings: listSize fails unless `key` is a list; item(key, i) is its i-th mapping, named
+  // key[i] in messages and finished with this node.
+  std::size_t listSize(const std::string& key);
+  StrictNode& item(const std::string& key, std::size_t index);
 
   double number(const std::string& key);
   double positive(const std::string& key);     // > 0

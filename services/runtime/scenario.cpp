@@ -1,0 +1,136 @@
+#include "services/runtime/scenario.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+#include "model/config/strict_yaml.hpp"
+
+namespace mft::services {
+
+using config::StrictNode;
+
+const char* toString(LocomotionMode m) {
+  switch (m) {
+    case LocomotionMode::Stand: return "stand";
+    case LocomotionMode::StepInPlace: return "step_in_place";
+    case LocomotionMode::Walk: return "walk";
+  }
+  return "?";
+}
+
+namespace {
+
+LocomotionMode parseMode(StrictNode& n, const std::string& key) {
+  const std::string s = n.text(key);
+  if (s == "stand") return LocomotionMode::Stand;
+  if (s == "step_in_place") return LocomotionMode::StepInPlace;
+  if (s == "walk") return LocomotionMode::Walk;
+  n.fail(key, "unknown mode '" + s + "' (expected stand, step_in_place or walk)");
+}
+
+std::string oneOf(StrictNode& n, const std::string& key, std::initializer_list<const char*> allowed) {
+  const std::string s = n.text(key);
+  std::string list;
+  for (const char* a : allowed) {
+    if (s == a) return s;
+    list += (list.empty() ? "" : ", ") + std::string(a);
+  }
+  n.fail(key, "unknown value '" + s + "' (expected one of " + list + ")");
+}
+
+Scenario read(StrictNode& root) {
+  Scenario s;
+  s.source_file = root.file();
+  const int version = root.integer("schema_version");
+  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
+  s.name = root.text("name");
+  s.description = root.has("description") ? root.text("description") : "";
+  s.duration_s = root.inRange("duration_s", 0.001, 3600.0);
+  s.controller = oneOf(root, "controller", {"mft", "sa", "none"});
+  s.estimator = oneOf(root, "estimator", {"kalman", "ground_truth"});
+  s.terrain = root.text("terrain");
+  if (s.terrain.empty() || s.terrain.find('/') != std::string::npos)
+    root.fail("terrain", "expected a terrain name from config/terrain/ (no path)");
+  s.initial_base_height_m = root.inRange("initial_base_height_m", 0.1, 1.0);
+  auto& fall = root.child("fall");
+  s.fall_base_height_m = fall.inRange("base_height_below_m", 0.0, 1.0);
+  s.fall_pitch_rad = fall.inRange("pitch_beyond_rad", 0.0, 3.2);
+
+  const std::size_t n_commands = root.listSize("commands");
+  if (n_commands == 0) root.fail("commands", "at least one command (at_s: 0) is needed");
+  for (std::size_t i = 0; i < n_commands; ++i) {
+    auto& c = root.item("commands", i);
+    ScenarioCommand cmd;
+    cmd.at_s = c.inRange("at_s", 0.0, s.duration_s);
+    cmd.mode = parseMode(c, "mode");
+    cmd.z_cmd_m = c.inRange("z_cmd_m", 0.1, 1.0);
+    cmd.v_cmd_mps = c.inRange("v_cmd_mps", -3.0, 3.0);
+    if (!s.commands.empty() && cmd.at_s < s.commands.back().at_s) c.fail("at_s", "commands must be in time order");
+    s.commands.push_back(cmd);
+  }
+  if (s.commands.front().at_s != 0.0) root.fail("commands", "the first command must be at_s: 0");
+
+  if (root.has("pushes")) {
+    const std::size_t n_pushes = root.listSize("pushes");
+    for (std::size_t i = 0; i < n_pushes; ++i) {
+      auto& p = root.item("pushes", i);
+      ScenarioPush push;
+      push.impulse_Ns = p.inRange("impulse_Ns", -100.0, 100.0);
+      push.at_s = p.inRange("at_s", 0.0, s.duration_s);
+      if (p.has("at_liftoff")) {
+        const std::string leg = oneOf(p, "at_liftoff", {"right", "left"});
+        push.at_liftoff_leg = leg == "right" ? 0 : 1;
+      }
+      s.pushes.push_back(push);
+    }
+  }
+  root.finish();
+  return s;
+}
+
+}  // namespace
+
+Scenario loadScenario(const std::string& path) {
+  auto root = StrictNode::loadFile(path);
+  return read(root);
+}
+
+Scenario parseScenario(const std::string& yaml_text, const std::string& origin) {
+  auto root = StrictNode::loadString(yaml_text, origin);
+  return read(root);
+}
+
+std::string Scenario::toJson() const {
+  auto esc = [](const std::string& in) {
+    std::string out;
+    for (char c : in) {
+      if (c == '"' || c == '\\') out += '\\';
+      if (c == '\n') {
+        out += "\\n";
+        continue;
+      }
+      out += c;
+    }
+    return out;
+  };
+  std::ostringstream o;
+  o.precision(17);
+  o << "{\"name\": \"" << esc(name) << "\", \"file\": \"" << esc(source_file) << "\", \"duration_s\": " << duration_s
+    << ", \"controller\": \"" << controller << "\", \"estimator\": \"" << estimator << "\", \"terrain\": \""
+    << esc(terrain) << "\", \"initial_base_height_m\": " << initial_base_height_m
+    << ", \"fall\": {\"base_height_below_m\": " << fall_base_height_m << ", \"pitch_beyond_rad\": " << fall_pitch_rad
+    << "}, \"commands\": [";
+  for (std::size_t i = 0; i < commands.size(); ++i)
+    o << (i ? ", " : "") << "{\"at_s\": " << commands[i].at_s << ", \"mode\": \"" << toString(commands[i].mode)
+      << "\", \"z_cmd_m\": " << commands[i].z_cmd_m << ", \"v_cmd_mps\": " << commands[i].v_cmd_mps << "}";
+  o << "], \"pushes\": [";
+  for (std::size_t i = 0; i < pushes.size(); ++i)
+    o << (i ? ", " : "") << "{\"impulse_Ns\": " << pushes[i].impulse_Ns << ", \"at_s\": " << pushes[i].at_s
+      << ", \"at_liftoff\": "
+      << (pushes[i].at_liftoff_leg < 0 ? "null" : (pushes[i].at_liftoff_leg == 0 ? "\"right\"" : "\"left\"")) << "}";
+  o << "]}";
+  return o.str();
+}
+
+}  // namespace mft::services

@@ -1,0 +1,48 @@
+#pragma once
+// Experiment scenarios (config/scenarios/*.yaml): what a stack runs, for how long, with which controller,
+// on which terrain, and the operator commands and pushes to play at simulated times or events.
+// One strict loader serves every service and the supervisor (`mft-sim --check-scenario FILE --json`).
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mft::services {
+
+enum class LocomotionMode { Stand, StepInPlace, Walk };
+const char* toString(LocomotionMode m);
+
+struct ScenarioCommand {
+  double at_s = 0.0;
+  LocomotionMode mode = LocomotionMode::Stand;
+  double z_cmd_m = 0.0;
+  double v_cmd_mps = 0.0;
+};
+
+struct ScenarioPush {
+  double impulse_Ns = 0.0;  // sagittal, + forward
+  double at_s = 0.0;        // applied at this time, or (with at_liftoff) armed from this time
+  int at_liftoff_leg = -1;  // -1: at time; 0 right, 1 left: at that leg's next lift-off after at_s
+};
+
+struct Scenario {
+  std::string source_file;
+  std::string name;
+  std::string description;
+  double duration_s = 0.0;
+  std::string controller;   // mft | sa | none
+  std::string estimator;    // kalman | ground_truth
+  std::string terrain;      // a file name in config/terrain/ without .yaml
+  double initial_base_height_m = 0.0;
+  std::vector<ScenarioCommand> commands;  // sorted by time, the first at 0
+  std::vector<ScenarioPush> pushes;
+  double fall_base_height_m = 0.0;        // the run counts as a fall below this base height
+  double fall_pitch_rad = 0.0;            // ... or beyond this |pitch|
+
+  std::string toJson() const;
+};
+
+// Loads and validates a scenario file; throws mft::config::ConfigError naming the file and key.
+Scenario loadScenario(const std::string& path);
+Scenario parseScenario(const std::string& yaml_text, const std::string& origin);
+
+}  // namespace mft::services

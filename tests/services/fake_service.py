@@ -1,0 +1,69 @@
+#!/usr/bin/env python3
+"""A stand-in for any mft-<service> executable that follows the supervisor's service contract, so the
+supervisor's own logic (readiness, restart with back-off, failure handling, clean stop, no orphans) is tested
+without DDS. Behaviour per service comes from FAKE_SERVICES, e.g. "mft-wbc:crash_after=0.3:crash_times=1".
+The pids it ran as are appended to $FAKE_PID_LOG."""
+import json
+import os
+import signal
+import sys
+import time
+from pathlib import Path
+
+name = Path(sys.argv[0]).name
+args = sys.argv[1:]
+
+
+def opt(key, default=None):
+    return args[args.index(key) + 1] if key in args else default
+
+
+if "--check-scenario" in args:
+    path = Path(opt("--check-scenario"))
+    text = path.read_text()
+    fields = dict(l.split(":", 1) for l in text.splitlines() if ":" in l and not l.startswith((" ", "#")))
+    print(json.dumps({"name": fields["name"].strip(), "duration_s": float(fields["duration_s"].split("#")[0])}))
+    sys.exit(0)
+
+behaviour = {}
+for spec in os.environ.get("FAKE_SERVICES", "").split(","):
+    parts = spec.split(":")
+    if parts[0] == name:
+        behaviour = dict(p.split("=") for p in parts[1:])
+with open(os.environ["FAKE_PID_LOG"], "a") as f:
+    f.write(f"{name} {os.getpid()}\n")
+
+# Crash count across restarts: a file per service in the run folder.
+summary_path = Path(opt("--summary"))
+crash_file = summary_path.with_suffix(".crashes")
+crashes = int(crash_file.read_text()) if crash_file.exists() else 0
+
+stop = False
+
+
+def on_term(*_):
+    global stop
+    stop = True
+
+
+signal.signal(signal.SIGTERM, on_term)
+signal.signal(signal.SIGINT, on_term)
+print(f"READY {name}", flush=True)
+t0 = time.monotonic()
+run_for = float(behaviour.get("run_for", "1e9"))
+crash_after = float(behaviour.get("crash_after", "1e9"))
+crash_times = int(behaviour.get("crash_times", "1000"))
+while not stop:
+    t = time.monotonic() - t0
+    if t > crash_after and crashes < crash_times:
+        crash_file.write_text(str(crashes + 1))
+        os._exit(3)
+    if t > run_for:
+        break
+    time.sleep(0.01)
+summary = {"service": name, "ran_s": time.monotonic() - t0}
+if name == "mft-sim":
+    summary.update({"fell": False, "sim_time_s": 1.0, "ticks": 1000, "deadline_misses": 0})
+if name == "mft-wbc":
+    summary.update({"solve_time_us": {"mean": 5.0, "p99": 9.0, "max": 20.0}, "safety_events": 0})
+summary_path.write_text(json.dumps(summary))

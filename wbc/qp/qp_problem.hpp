@@ -40,9 +40,15 @@ struct QpSolution {
   // Active set at the solution, length n + nin: +1 active at upper, -1 at lower, 0 inactive
   // (the convention of shared/qp/FORMAT.md, active_ref). Equalities are always active and not listed.
   Eigen::VectorXi active;
-  // Lagrange multipliers: equalities (neq), and for bounds (n) and rows (nin) signed so that
-  // H x + g = Aeq' y_eq + sum over active... (see qp_solver.hpp for the exact convention).
+  // Lagrange multipliers: equalities (neq), bounds (n) and rows (nin), signed so that
+  //   H x + g = Aeq' y_eq + y_bounds + Ain' y_rows,
+  // y > 0: the lower side binds, y < 0: the upper side binds, 0: inactive (fixed variables / lbA == ubA: any sign).
   Eigen::VectorXd y_eq, y_bounds, y_rows;
+  // Sizes every vector for a problem of these dimensions (no allocation when the sizes already match).
+  void resize(int n, int neq, int nin);
 };
+
+// Smallest k >= 1 such that H = blkdiag(H[0:k,0:k], diagonal): a value for QpProblem::dense_block (n if H is dense).
+int detectDenseBlock(const Eigen::MatrixXd& H);
 
 }  // namespace mft::qp

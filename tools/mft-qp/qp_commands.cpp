@@ -1,0 +1,243 @@
+#include "qp_commands.hpp"
+
+#include <malloc.h>
+#include <sched.h>
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#include "wbc/qp/qp_io.hpp"
+#include "wbc/qp/qp_kkt.hpp"
+#include "wbc/qp/qp_solver.hpp"
+
+namespace mft::tools {
+namespace {
+
+using qp::QpInstance;
+using qp::QpSolution;
+using qp::QpStatus;
+
+struct Accuracy {
+  double x_err = 0.0;   // max |x - x_ref| (NaN-safe: a non-finite difference counts as +inf)
+  double kkt = 0.0;     // max KKT residual
+  int mismatched = 0;   // entries differing from active_ref
+  int strict_mismatched = 0;  // of which not explained by a degenerate (zero multiplier / tight) constraint
+};
+
+Accuracy checkSolution(const QpInstance& inst, const QpSolution& s) {
+  Accuracy a;
+  const qp::QpProblem& p = inst.problem;
+  if (inst.x_ref) {
+    for (int j = 0; j < p.n; ++j) {
+      const double e = std::abs(s.x[j] - (*inst.x_ref)[j]);
+      a.x_err = std::isnan(e) ? qp::kInf : std::max(a.x_err, e);
+    }
+  }
+  a.kkt = qp::kktResiduals(p, s).max();
+  if (inst.active_ref) {
+    const Eigen::VectorXd rows = p.Ain * s.x;
+    for (int i = 0; i < p.n + p.nin; ++i) {
+      const int ours = s.active[i], ref = (*inst.active_ref)[i];
+      if (ours == ref) continue;
+      ++a.mismatched;
+      const bool bound = i < p.n;
+      const int k = bound ? i : i - p.n;
+      const double v = bound ? s.x[k] : rows[k];
+      const double y = bound ? s.y_bounds[k] : s.y_rows[k];
+      const double lo = bound ? p.lb[k] : p.lbA[k], hi = bound ? p.ub[k] : p.ubA[k];
+      // Degenerate: the reference's side is tight at our x and our multiplier there is ~0, or vice versa.
+      const double tight_tol = 1e-7 * (1.0 + std::abs(v));
+      const bool ref_tight = ref == 0 || (ref < 0 ? std::abs(v - lo) <= tight_tol : std::abs(hi - v) <= tight_tol);
+      const bool ours_weak = ours == 0 || std::abs(y) <= 1e-7 || lo == hi;
+      if (!(ref_tight && ours_weak)) ++a.strict_mismatched;
+    }
+  }
+  return a;
+}
+
+std::vector<QpInstance> loadFolder(const std::string& dir) {
+  const std::vector<std::string> files = qp::listQpInstanceFiles(dir);
+  if (files.empty()) throw qp::QpIoError(dir + ": no *.txt instances");
+  std::vector<QpInstance> out;
+  out.reserve(files.size());
+  for (const std::string& f : files) out.push_back(qp::readQpInstance(f));
+  return out;
+}
+
+// Real-time hygiene as in QP.md section 1; every step degrades gracefully and is reported.
+std::string prepareProcess(int cpu) {
+  std::string notes;
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, -1);
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0)
+    notes += "mlockall ok";
+  else
+    notes += std::string("mlockall unavailable (") + std::strerror(errno) + ")";
+  if (cpu >= 0) {
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    CPU_SET(cpu, &set);
+    if (sched_setaffinity(0, sizeof set, &set) == 0)
+      notes += "; pinned to cpu " + std::to_string(cpu);
+    else
+      notes += "; pinning to cpu " + std::to_string(cpu) + " failed (" + std::strerror(errno) + ")";
+  } else {
+    notes += "; not pinned";
+  }
+  return notes;
+}
+
+double percentile(const std::vector<double>& sorted, double p) {
+  const std::size_t i = std::min(sorted.size() - 1, static_cast<std::size_t>(p * static_cast<double>(sorted.size())));
+  return sorted[i];
+}
+
+std::string num(double v) {
+  if (std::isnan(v)) return "null";
+  if (std::isinf(v)) return v > 0 ? "1e308" : "-1e308";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+int runBench(const BenchOptions& o) {
+  const std::vector<QpInstance> instances = loadFolder(o.dir);
+  const std::string notes = prepareProcess(o.cpu);
+  const std::size_t count = instances.size();
+  std::vector<double> best(count, qp::kInf);
+  double raw_max = 0.0;
+  int failures = 0, fallbacks = 0;
+  long long iterations_sum = 0;
+  int iterations_max = 0;
+  Accuracy worst;
+  int steps_mismatched = 0, steps_strict = 0;
+
+  for (int pass = 0; pass < o.passes; ++pass) {
+    // A fresh solver per pass: every pass starts without warm-start state.
+    const qp::QpProblem& first = instances.front().problem;
+    qp::GoldfarbIdnaniSolver solver(first.n, first.neq, first.nin);
+    solver.options().warm_start = o.warm;
+    QpSolution sol;
+    sol.resize(first.n, first.neq, first.nin);
+    for (std::size_t k = 0; k < count; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const QpStatus st = solver.solve(instances[k].problem, &sol);
+      const auto t1 = std::chrono::steady_clock::now();
+      const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
+      best[k] = std::min(best[k], us);
+      raw_max = std::max(raw_max, us);
+      if (pass != o.passes - 1) continue;
+      // Accuracy from the last pass (every pass solves the same problems the same way).
+      fallbacks += solver.lastSolveFellBack() ? 1 : 0;
+      iterations_sum += sol.iterations;
+      iterations_max = std::max(iterations_max, sol.iterations);
+      if (st != QpStatus::Optimal) {
+        ++failures;
+        if (!o.json) std::cerr << instances[k].name << ": " << qp::toString(st) << "\n";
+        continue;
+      }
+      const Accuracy a = checkSolution(instances[k], sol);
+      worst.x_err = std::max(worst.x_err, a.x_err);
+      worst.kkt = std::max(worst.kkt, a.kkt);
+      worst.mismatched += a.mismatched;
+      worst.strict_mismatched += a.strict_mismatched;
+      steps_mismatched += a.mismatched ? 1 : 0;
+      steps_strict += a.strict_mismatched ? 1 : 0;
+    }
+  }
+  std::vector<double> sorted = best;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0.0;
+  for (double v : sorted) sum += v;
+  const double mean = sum / static_cast<double>(count);
+  const double iter_mean = static_cast<double>(iterations_sum) / static_cast<double>(count);
+
+  if (o.json) {
+    std::cout << "{\"dir\": " << jsonString(o.dir) << ", \"count\": " << count << ", \"passes\": " << o.passes
+              << ", \"warm\": " << (o.warm ? "true" : "false") << ", \"failures\": " << failures
+              << ", \"warm_fallbacks\": " << fallbacks << ", \"max_x_err\": " << num(worst.x_err)
+              << ", \"max_kkt\": " << num(worst.kkt) << ", \"active_mismatch_steps\": " << steps_mismatched
+              << ", \"active_mismatch_steps_nondegenerate\": " << steps_strict
+              << ", \"iterations_mean\": " << num(iter_mean) << ", \"iterations_max\": " << iterations_max
+              << ", \"mean_us\": " << num(mean) << ", \"p50_us\": " << num(percentile(sorted, 0.5))
+              << ", \"p99_us\": " << num(percentile(sorted, 0.99)) << ", \"max_us\": " << num(sorted.back())
+              << ", \"raw_max_us\": " << num(raw_max) << ", \"process\": " << jsonString(notes) << "}\n";
+  } else {
+    std::printf("instances            %zu (%s)\n", count, o.dir.c_str());
+    std::printf("mode                 %s, %d passes, per-step minimum over passes (%s)\n", o.warm ? "warm" : "cold",
+                o.passes, notes.c_str());
+    std::printf("failures             %d%s\n", failures, o.warm ? (" (warm fallbacks " + std::to_string(fallbacks) + ")").c_str() : "");
+    std::printf("max |x - x_ref|      %.3g\n", worst.x_err);
+    std::printf("max KKT residual     %.3g\n", worst.kkt);
+    std::printf("active-set mismatch  %d steps (%d entries); not explained by degeneracy: %d steps\n", steps_mismatched,
+                worst.mismatched, steps_strict);
+    std::printf("iterations           mean %.2f, max %d\n", iter_mean, iterations_max);
+    std::printf("solve time [us]      mean %.2f  p50 %.2f  p99 %.2f  max %.2f  (raw max %.2f)\n", mean,
+                percentile(sorted, 0.5), percentile(sorted, 0.99), sorted.back(), raw_max);
+  }
+  return failures ? 1 : 0;
+}
+
+int runSolve(const SolveOptions& o) {
+  const QpInstance inst = qp::readQpInstance(o.file);
+  const qp::QpProblem& p = inst.problem;
+  qp::GoldfarbIdnaniSolver solver(p.n, p.neq, p.nin);
+  QpSolution sol;
+  sol.resize(p.n, p.neq, p.nin);
+  const auto t0 = std::chrono::steady_clock::now();
+  const QpStatus st = solver.solve(p, &sol);
+  const auto t1 = std::chrono::steady_clock::now();
+  const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
+  const qp::KktResiduals kkt = qp::kktResiduals(p, sol);
+  const Accuracy a = checkSolution(inst, sol);
+  std::ostringstream active;
+  for (int i = 0; i < p.n + p.nin; ++i)
+    if (sol.active[i]) active << (active.tellp() ? " " : "") << (i < p.n ? "x" : "row") << (i < p.n ? i : i - p.n) << (sol.active[i] > 0 ? "+" : "-");
+  if (o.json) {
+    std::cout << "{\"file\": " << jsonString(o.file) << ", \"name\": " << jsonString(inst.name)
+              << ", \"status\": " << jsonString(qp::toString(st)) << ", \"iterations\": " << sol.iterations
+              << ", \"objective\": " << num(sol.objective)
+              << ", \"f_ref\": " << (inst.f_ref ? num(*inst.f_ref) : "null")
+              << ", \"max_x_err\": " << (inst.x_ref ? num(a.x_err) : "null")
+              << ", \"kkt\": {\"stationarity\": " << num(kkt.stationarity) << ", \"primal\": " << num(kkt.primal)
+              << ", \"dual\": " << num(kkt.dual) << ", \"complementarity\": " << num(kkt.complementarity) << "}"
+              << ", \"active_mismatch\": " << (inst.active_ref ? std::to_string(a.mismatched) : "null")
+              << ", \"active\": " << jsonString(active.str()) << ", \"solve_us\": " << num(us) << ", \"x\": [";
+    for (int j = 0; j < p.n; ++j) std::cout << (j ? ", " : "") << num(sol.x[j]);
+    std::cout << "]}\n";
+  } else {
+    std::printf("instance        %s (%s)\n", inst.name.c_str(), o.file.c_str());
+    std::printf("status          %s, %d iterations, %.2f us (single cold call)\n", qp::toString(st), sol.iterations, us);
+    std::printf("objective       %.17g", sol.objective);
+    if (inst.f_ref) std::printf("  (f_ref %.17g)", *inst.f_ref);
+    std::printf("\n");
+    if (inst.x_ref) std::printf("max |x - x_ref| %.3g\n", a.x_err);
+    std::printf("KKT             stationarity %.3g  primal %.3g  dual %.3g  complementarity %.3g\n", kkt.stationarity,
+                kkt.primal, kkt.dual, kkt.complementarity);
+    std::printf("active          %s\n", active.str().c_str());
+    if (inst.active_ref) std::printf("vs active_ref   %d entries differ (%d not explained by degeneracy)\n", a.mismatched, a.strict_mismatched);
+  }
+  return st == QpStatus::Optimal ? 0 : 1;
+}
+
+}  // namespace mft::tools

@@ -1,0 +1,260 @@
+#include "wbc/qp/qp_io.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace mft::qp {
+namespace {
+
+class Tokens {
+ public:
+  Tokens(const std::string& text, const std::string& source) : text_(text), source_(source) {}
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw QpIoError(source_ + ": " + what + " (near token " + std::to_string(count_) + ")");
+  }
+  bool atEnd() {
+    skipSpace();
+    return pos_ >= text_.size();
+  }
+  std::string word(const char* what) {
+    skipSpace();
+    if (pos_ >= text_.size()) fail(std::string("unexpected end of file, expected ") + what);
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    ++count_;
+    return text_.substr(start, pos_ - start);
+  }
+  long long integer(const char* what) {
+    const std::string w = word(what);
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(w.c_str(), &end, 10);
+    if (w.empty() || *end != '\0' || errno != 0) fail(std::string("expected an integer for ") + what + ", got '" + w + "'");
+    return v;
+  }
+  double number(const char* what) {
+    const std::string w = word(what);
+    char* end = nullptr;
+    const double v = std::strtod(w.c_str(), &end);
+    if (w.empty() || *end != '\0' || std::isnan(v)) fail(std::string("expected a number for ") + what + ", got '" + w + "'");
+    return v;
+  }
+
+ private:
+  void skipSpace() {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+  }
+  const std::string& text_;
+  const std::string& source_;
+  std::size_t pos_ = 0;
+  long long count_ = 0;
+};
+
+void expectSize(Tokens& t, const std::string& key, long long got, long long want, const char* which) {
+  if (got != want)
+    t.fail("record '" + key + "' has " + which + " " + std::to_string(got) + ", dims require " + std::to_string(want));
+}
+
+void readMatrix(Tokens& t, const std::string& key, Eigen::MatrixXd& m, int rows, int cols) {
+  expectSize(t, key, t.integer("rows"), rows, "rows");
+  expectSize(t, key, t.integer("cols"), cols, "cols");
+  m.resize(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) m(i, j) = t.number(key.c_str());
+}
+
+void readVector(Tokens& t, const std::string& key, Eigen::VectorXd& v, int len) {
+  expectSize(t, key, t.integer("length"), len, "length");
+  v.resize(len);
+  for (int i = 0; i < len; ++i) v[i] = t.number(key.c_str());
+}
+
+void appendNumber(std::string& out, double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);  // prints inf / -inf for infinities
+  out += buf;
+}
+
+void appendVector(std::string& out, const char* key, const Eigen::VectorXd& v) {
+  out += key;
+  out += ' ' + std::to_string(v.size()) + '\n';
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i) out += ' ';
+    appendNumber(out, v[i]);
+  }
+  out += '\n';
+}
+
+void appendMatrix(std::string& out, const char* key, const Eigen::MatrixXd& m) {
+  out += std::string(key) + ' ' + std::to_string(m.rows()) + ' ' + std::to_string(m.cols()) + '\n';
+  for (Eigen::Index i = 0; i < m.rows(); ++i) {
+    for (Eigen::Index j = 0; j < m.cols(); ++j) {
+      if (j) out += ' ';
+      appendNumber(out, m(i, j));
+    }
+    out += '\n';
+  }
+}
+
+}  // namespace
+
+QpInstance parseQpInstance(const std::string& text, const std::string& source) {
+  Tokens t(text, source);
+  if (t.word("magic") != "WBCQP") t.fail("not a WBCQP file (first token must be 'WBCQP')");
+  const long long version = t.integer("version");
+  if (version != 1) t.fail("unsupported WBCQP version " + std::to_string(version) + " (this reader knows 1)");
+
+  QpInstance inst;
+  QpProblem& p = inst.problem;
+  bool have_dims = false, ended = false;
+  std::set<std::string> seen;
+  const std::set<std::string> repeatable = {"varblock", "rowblock"};
+  const std::set<std::string> known = {"name", "step", "dims", "varblock", "rowblock", "H", "g", "Aeq", "beq", "Ain",
+                                       "lbA", "ubA", "lb", "ub", "x_ref", "f_ref", "active_ref", "end"};
+  while (!t.atEnd()) {
+    const std::string key = t.word("record");
+    if (!known.count(key)) t.fail("unknown record '" + key + "'");
+    if (!repeatable.count(key) && !seen.insert(key).second) t.fail("duplicate record '" + key + "'");
+    const bool sized = key != "name" && key != "step" && key != "dims" && key != "end" && key != "f_ref";
+    if (sized && !repeatable.count(key) && !have_dims) t.fail("record '" + key + "' before 'dims'");
+    if (key == "end") {
+      ended = true;
+      break;
+    } else if (key == "name") {
+      inst.name = t.word("name");
+    } else if (key == "step") {
+      inst.step = t.integer("step");
+    } else if (key == "dims") {
+      const long long n = t.integer("n"), neq = t.integer("neq"), nin = t.integer("nin");
+      if (n < 0 || neq < 0 || nin < 0 || n > 100000 || neq > 100000 || nin > 100000) t.fail("implausible dims");
+      p.resize(static_cast<int>(n), static_cast<int>(neq), static_cast<int>(nin));
+      have_dims = true;
+    } else if (key == "varblock" || key == "rowblock") {
+      QpBlock b;
+      b.name = t.word("block name");
+      b.first = static_cast<int>(t.integer("block first"));
+      b.length = static_cast<int>(t.integer("block length"));
+      if (b.first < 0 || b.length < 0) t.fail("negative " + key + " '" + b.name + "'");
+      (key == "varblock" ? inst.varblocks : inst.rowblocks).push_back(b);
+    } else if (key == "H") {
+      readMatrix(t, key, p.H, p.n, p.n);
+    } else if (key == "Aeq") {
+      readMatrix(t, key, p.Aeq, p.neq, p.n);
+    } else if (key == "Ain") {
+      readMatrix(t, key, p.Ain, p.nin, p.n);
+    } else if (key == "g") {
+      readVector(t, key, p.g, p.n);
+    } else if (key == "beq") {
+      readVector(t, key, p.beq, p.neq);
+    } else if (key == "lbA") {
+      readVector(t, key, p.lbA, p.nin);
+    } else if (key == "ubA") {
+      readVector(t, key, p.ubA, p.nin);
+    } else if (key == "lb") {
+      readVector(t, key, p.lb, p.n);
+    } else if (key == "ub") {
+      readVector(t, key, p.ub, p.n);
+    } else if (key == "x_ref") {
+      inst.x_ref.emplace();
+      readVector(t, key, *inst.x_ref, p.n);
+    } else if (key == "f_ref") {
+      inst.f_ref = t.number("f_ref");
+    } else if (key == "active_ref") {
+      expectSize(t, key, t.integer("length"), p.n + p.nin, "length");
+      Eigen::VectorXi a(p.n + p.nin);
+      for (int i = 0; i < a.size(); ++i) {
+        const long long v = t.integer("active_ref");
+        if (v < -1 || v > 1) t.fail("active_ref entries must be -1, 0 or 1");
+        a[i] = static_cast<int>(v);
+      }
+      inst.active_ref = a;
+    }
+  }
+  if (!ended) t.fail("missing 'end' record");
+  if (!t.atEnd()) t.fail("text after 'end'");
+  for (const char* required : {"name", "dims", "H", "g", "Aeq", "beq", "Ain", "lbA", "ubA", "lb", "ub"})
+    if (!seen.count(required)) t.fail(std::string("missing record '") + required + "'");
+  for (const QpBlock& b : inst.varblocks)
+    if (b.first + b.length > p.n) t.fail("varblock '" + b.name + "' exceeds n");
+  p.dense_block = detectDenseBlock(p.H);
+  return inst;
+}
+
+QpInstance readQpInstance(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw QpIoError(path + ": cannot open file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw QpIoError(path + ": read error");
+  return parseQpInstance(ss.str(), path);
+}
+
+std::string formatQpInstance(const QpInstance& inst) {
+  const QpProblem& p = inst.problem;
+  std::string out;
+  out.reserve(static_cast<std::size_t>(26) * (p.n * (p.n + p.neq + p.nin + 8) + 4 * p.nin) + 1024);
+  out += "WBCQP 1\nname " + inst.name + '\n';
+  if (inst.step) out += "step " + std::to_string(*inst.step) + '\n';
+  out += "dims " + std::to_string(p.n) + ' ' + std::to_string(p.neq) + ' ' + std::to_string(p.nin) + '\n';
+  for (const QpBlock& b : inst.varblocks)
+    out += "varblock " + b.name + ' ' + std::to_string(b.first) + ' ' + std::to_string(b.length) + '\n';
+  for (const QpBlock& b : inst.rowblocks)
+    out += "rowblock " + b.name + ' ' + std::to_string(b.first) + ' ' + std::to_string(b.length) + '\n';
+  appendMatrix(out, "H", p.H);
+  appendVector(out, "g", p.g);
+  appendMatrix(out, "Aeq", p.Aeq);
+  appendVector(out, "beq", p.beq);
+  appendMatrix(out, "Ain", p.Ain);
+  appendVector(out, "lbA", p.lbA);
+  appendVector(out, "ubA", p.ubA);
+  appendVector(out, "lb", p.lb);
+  appendVector(out, "ub", p.ub);
+  if (inst.x_ref) appendVector(out, "x_ref", *inst.x_ref);
+  if (inst.f_ref) {
+    out += "f_ref ";
+    appendNumber(out, *inst.f_ref);
+    out += '\n';
+  }
+  if (inst.active_ref) {
+    out += "active_ref " + std::to_string(inst.active_ref->size()) + '\n';
+    for (Eigen::Index i = 0; i < inst.active_ref->size(); ++i) {
+      if (i) out += ' ';
+      out += std::to_string((*inst.active_ref)[i]);
+    }
+    out += '\n';
+  }
+  out += "end\n";
+  return out;
+}
+
+void writeQpInstance(const std::string& path, const QpInstance& inst) {
+  const std::string text = formatQpInstance(inst);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw QpIoError(path + ": cannot open for writing");
+  out << text;
+  out.flush();
+  if (!out) throw QpIoError(path + ": write error");
+}
+
+std::vector<std::string> listQpInstanceFiles(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw QpIoError(dir + ": not a directory");
+  std::vector<std::string> files;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (it->path().extension() == ".txt" && it->is_regular_file(ec)) files.push_back(it->path().string());
+  if (ec) throw QpIoError(dir + ": " + ec.message());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+}  // namespace mft::qp

@@ -40,6 +40,14 @@ struct PlanarModel {
 
 PlanarModel buildBipedModel(const RobotDescription& d);
 
+// World-frame kinematics of one body frame (origin = its proximal joint). bias_acceleration is the origin's
+// acceleration at qdd = 0 (velocity-product terms only; the angular one is zero in the plane).
+struct BodyKinematics {
+  double angle = 0.0;   // absolute CCW angle of the body frame
+  double omega = 0.0;   // absolute angular velocity
+  Eigen::Vector2d origin{0, 0}, velocity{0, 0}, bias_acceleration{0, 0};
+};
+
 // Everything one control tick needs, preallocated: updateModel fills it without allocating.
 struct ModelData {
   MatrixQ M = MatrixQ::Zero();       // mass matrix
@@ -60,9 +68,16 @@ struct ModelData {
   std::array<Eigen::Matrix3d, kNq> Ic{};            // composite inertias
   std::array<Eigen::Vector3d, kNq> S{};             // joint motion subspaces
   std::array<Eigen::Matrix3d, kNq> X_base{};        // world-to-body transforms
+  // Added with the implementation (backward compatible): the state of the last updateModel call, the
+  // world-frame body kinematics it computed and the total mass.
+  VectorQ q = VectorQ::Zero(), qd = VectorQ::Zero();
+  std::array<BodyKinematics, kNq> body{};
+  double total_mass = 0.0;
 };
 
 // Fills every field of ModelData at (q, qd): the full per-tick model update. Allocation-free.
+// The model must be a tree in topological order (parent < index) with kNq bodies, as buildBipedModel makes
+// it; otherwise these functions throw std::invalid_argument.
 void updateModel(const PlanarModel& model, const VectorQ& q, const VectorQ& qd, ModelData* data);
 
 // Pieces of updateModel, usable on their own.
@@ -94,7 +109,8 @@ struct ClosureProjection {
 };
 void closureProjection(const ModelData& data, ClosureProjection* out);
 
-// Paper eq. 7: actuated torques realising qdd with contact forces f_c.
+// Paper eq. 7: actuated torques realising qdd with contact forces f_c. Uses data.Jh_dot_qd, i.e. the velocity
+// of the last updateModel call; qd must be that velocity (checked in debug builds).
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c);
 

@@ -1,0 +1,114 @@
+#include "services/runtime/convert.hpp"
+
+namespace mft::services {
+
+namespace {
+template <class Array, class Vec>
+void copyIn(const Array& a, Vec* v) {
+  for (std::size_t i = 0; i < a.size(); ++i) (*v)[static_cast<long>(i)] = a[i];
+}
+template <class Vec, class Array>
+void copyOut(const Vec& v, Array* a) {
+  for (std::size_t i = 0; i < a->size(); ++i) (*a)[i] = v[static_cast<long>(i)];
+}
+}  // namespace
+
+void toMsg(const model::SensorReadings& in, msg::SensorData* out) {
+  out->tick(in.tick);
+  out->stamp_ns(toStampNs(in.time_s));
+  out->actuated_pos(in.actuated_pos);
+  out->actuated_vel(in.actuated_vel);
+  out->passive_pos(in.passive_pos);
+  out->passive_vel(in.passive_vel);
+  out->sea_torque(in.sea_torque);
+  out->gyro_pitch_rate(in.gyro_pitch_rate);
+  out->accel(in.accel);
+  out->contact(in.contact);
+}
+
+void fromMsg(const msg::SensorData& in, model::SensorReadings* out) {
+  out->tick = in.tick();
+  out->time_s = fromStampNs(in.stamp_ns());
+  out->actuated_pos = in.actuated_pos();
+  out->actuated_vel = in.actuated_vel();
+  out->passive_pos = in.passive_pos();
+  out->passive_vel = in.passive_vel();
+  out->sea_torque = in.sea_torque();
+  out->gyro_pitch_rate = in.gyro_pitch_rate();
+  out->accel = in.accel();
+  out->contact = in.contact();
+}
+
+void toMsg(const model::GroundTruthState& in, msg::GroundTruth* out) {
+  out->tick(in.tick);
+  out->stamp_ns(toStampNs(in.time_s));
+  copyOut(in.q, &out->q());
+  copyOut(in.qd, &out->qd());
+  copyOut(in.contact_force, &out->contact_force());
+  out->lti(in.lti);
+}
+
+void fromMsg(const msg::GroundTruth& in, model::GroundTruthState* out) {
+  out->tick = in.tick();
+  out->time_s = fromStampNs(in.stamp_ns());
+  copyIn(in.q(), &out->q);
+  copyIn(in.qd(), &out->qd);
+  copyIn(in.contact_force(), &out->contact_force);
+  out->lti = in.lti();
+}
+
+void toMsg(const model::RobotStateEstimate& in, msg::RobotState* out) {
+  out->tick(in.tick);
+  out->stamp_ns(toStampNs(in.time_s));
+  copyOut(in.q, &out->q());
+  copyOut(in.qd, &out->qd());
+  out->contact(in.contact);
+}
+
+void fromMsg(const msg::RobotState& in, model::RobotStateEstimate* out) {
+  out->tick = in.tick();
+  out->time_s = fromStampNs(in.stamp_ns());
+  copyIn(in.q(), &out->q);
+  copyIn(in.qd(), &out->qd);
+  out->contact = in.contact();
+}
+
+void toMsg(const model::ActuatorCommand& in, std::uint64_t stamp_ns, std::uint64_t seq, msg::JointCommand* out) {
+  out->tick(in.tick);
+  out->stamp_ns(stamp_ns);
+  out->seq(seq);
+  copyOut(in.tau, &out->tau());
+  out->mode(in.mode == model::CommandMode::Damping ? msg::COMMAND_MODE_DAMPING : msg::COMMAND_MODE_NORMAL);
+}
+
+void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out) {
+  out->tick = in.tick();
+  copyIn(in.tau(), &out->tau);
+  out->mode = in.mode() == msg::COMMAND_MODE_DAMPING ? model::CommandMode::Damping : model::CommandMode::Normal;
+}
+
+void toMsg(const planner::PlanOutput& in, msg::Reference* out) {
+  out->tick(in.tick);
+  out->stamp_ns(toStampNs(in.time_s));
+  out->step_index(in.step_index);
+  out->phase(in.phase);
+  out->stance_leg(static_cast<std::int16_t>(in.stance_leg));
+  out->foot_in_stance({in.foot[0].stance, in.foot[1].stance});
+  copyOut(in.base_z, &out->base_z());
+  copyOut(in.base_pitch, &out->base_pitch());
+  copyOut(in.footPos(), &out->foot_pos());
+  copyOut(in.footVel(), &out->foot_vel());
+  copyOut(in.footAcc(), &out->foot_acc());
+}
+
+void fromMsg(const msg::Reference& in, wbc::WbcReference* out) {
+  out->tick = in.tick();
+  out->foot_in_stance = in.foot_in_stance();
+  out->base_z = {in.base_z()[0], in.base_z()[1], in.base_z()[2]};
+  out->base_pitch = {in.base_pitch()[0], in.base_pitch()[1], in.base_pitch()[2]};
+  copyIn(in.foot_pos(), &out->foot_pos);
+  copyIn(in.foot_vel(), &out->foot_vel);
+  copyIn(in.foot_acc(), &out->foot_acc);
+}
+
+}  // namespace mft::services

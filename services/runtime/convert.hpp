@@ -1,0 +1,29 @@
+#pragma once
+// Conversions between the libraries' plain structs and the DDS messages. Kept in one place so that a field
+// added to a topic touches one file. Copies only: no allocation.
+#include "MftMsgs.h"
+#include "model/robot_io.hpp"
+#include "planner/plan_output.hpp"
+#include "wbc/wbc_reference.hpp"
+
+namespace mft::services {
+
+inline std::uint64_t toStampNs(double time_s) { return static_cast<std::uint64_t>(time_s * 1e9 + 0.5); }
+inline double fromStampNs(std::uint64_t ns) { return static_cast<double>(ns) * 1e-9; }
+
+void toMsg(const model::SensorReadings& in, msg::SensorData* out);
+void fromMsg(const msg::SensorData& in, model::SensorReadings* out);
+
+void toMsg(const model::GroundTruthState& in, msg::GroundTruth* out);
+void fromMsg(const msg::GroundTruth& in, model::GroundTruthState* out);
+
+void toMsg(const model::RobotStateEstimate& in, msg::RobotState* out);
+void fromMsg(const msg::RobotState& in, model::RobotStateEstimate* out);
+
+void toMsg(const model::ActuatorCommand& in, std::uint64_t stamp_ns, std::uint64_t seq, msg::JointCommand* out);
+void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out);
+
+void toMsg(const planner::PlanOutput& in, msg::Reference* out);
+void fromMsg(const msg::Reference& in, wbc::WbcReference* out);
+
+}  // namespace mft::services

@@ -2,7 +2,6 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
-#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -371,9 +370,7 @@ void closureProjection(const ModelData& data, ClosureProjection* out) {
 
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c) {
-  assert((qd - data.qd).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + data.qd.cwiseAbs().maxCoeff()) &&
-         "inverseDynamicsActuated: qd differs from the velocity of the last updateModel call");
-  (void)qd;
+  (void)qd;  // the velocity enters only through data.Jh_dot_qd (and data.h), computed by updateModel at it
   const MatrixQ NhT = proj.N_h.transpose();
   const VectorQ generalized = data.M * qdd + NhT * data.h +
                               data.Jh.transpose() * (proj.Lambda_h * data.Jh_dot_qd) -

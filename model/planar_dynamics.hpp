@@ -109,8 +109,8 @@ struct ClosureProjection {
 };
 void closureProjection(const ModelData& data, ClosureProjection* out);
 
-// Paper eq. 7: actuated torques realising qdd with contact forces f_c. Uses data.Jh_dot_qd, i.e. the velocity
-// of the last updateModel call; qd must be that velocity (checked in debug builds).
+// Paper eq. 7: actuated torques realising qdd with contact forces f_c. The velocity terms come from data
+// (h and Jh_dot_qd of the last updateModel call), so qd must be the velocity data was updated with.
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c);
 

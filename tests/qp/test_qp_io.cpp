@@ -1,0 +1,150 @@
+// WBCQP v1 reader/writer: bit-exact round trip of the shared instances, and loud failures on malformed files.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "wbc/qp/qp_io.hpp"
+
+using namespace mft::qp;
+
+namespace {
+
+std::string sharedFile(const char* name) {
+  return std::string(MFT_SHARED_DIR) + "/qp/instances/seq_1600_1799/" + name;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+template <class M>
+bool bitEqual(const M& a, const M& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() &&
+         std::memcmp(a.data(), b.data(), sizeof(typename M::Scalar) * static_cast<std::size_t>(a.size())) == 0;
+}
+
+void expectSame(const QpInstance& a, const QpInstance& b) {
+  EXPECT_EQ(a.name, b.name);
+  EXPECT_EQ(a.step, b.step);
+  const QpProblem &p = a.problem, &q = b.problem;
+  EXPECT_EQ(p.n, q.n);
+  EXPECT_EQ(p.neq, q.neq);
+  EXPECT_EQ(p.nin, q.nin);
+  EXPECT_EQ(p.dense_block, q.dense_block);
+  EXPECT_TRUE(bitEqual(p.H, q.H) && bitEqual(p.g, q.g) && bitEqual(p.Aeq, q.Aeq) && bitEqual(p.beq, q.beq) &&
+              bitEqual(p.Ain, q.Ain) && bitEqual(p.lbA, q.lbA) && bitEqual(p.ubA, q.ubA) && bitEqual(p.lb, q.lb) &&
+              bitEqual(p.ub, q.ub));
+  ASSERT_EQ(a.x_ref.has_value(), b.x_ref.has_value());
+  if (a.x_ref) {
+    EXPECT_TRUE(bitEqual(*a.x_ref, *b.x_ref));
+  }
+  ASSERT_EQ(a.f_ref.has_value(), b.f_ref.has_value());
+  if (a.f_ref) {
+    EXPECT_EQ(std::memcmp(&*a.f_ref, &*b.f_ref, sizeof(double)), 0);
+  }
+  ASSERT_EQ(a.active_ref.has_value(), b.active_ref.has_value());
+  if (a.active_ref) {
+    EXPECT_TRUE(bitEqual(*a.active_ref, *b.active_ref));
+  }
+  ASSERT_EQ(a.varblocks.size(), b.varblocks.size());
+  ASSERT_EQ(a.rowblocks.size(), b.rowblocks.size());
+}
+
+// Parses text that must be refused; returns the error message.
+std::string refusal(const std::string& text) {
+  try {
+    parseQpInstance(text, "bad_file.txt");
+  } catch (const QpIoError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return {};
+}
+
+const char* kSmall =
+    "WBCQP 1\nname small\ndims 2 1 1\nH 2 2\n2 0\n0 1\ng 2\n1 -1\nAeq 1 2\n1 1\nbeq 1\n0.5\nAin 1 2\n1 -1\n"
+    "lbA 1\n-inf\nubA 1\n3\nlb 2\n-inf 0\nub 2\ninf inf\nend\n";
+
+}  // namespace
+
+TEST(QpIo, ReadsASharedInstance) {
+  const QpInstance inst = readQpInstance(sharedFile("wbc_01600.txt"));
+  EXPECT_EQ(inst.name, "wbc_01600");
+  EXPECT_EQ(inst.step, 1600);
+  EXPECT_EQ(inst.problem.n, 27);
+  EXPECT_EQ(inst.problem.neq, 7);
+  EXPECT_EQ(inst.problem.nin, 20);
+  EXPECT_EQ(inst.problem.dense_block, 11);
+  ASSERT_EQ(inst.varblocks.size(), 3u);
+  EXPECT_EQ(inst.varblocks[2].name, "eps");
+  EXPECT_EQ(inst.rowblocks.size(), 5u);
+  EXPECT_TRUE(inst.x_ref && inst.f_ref && inst.active_ref);
+  EXPECT_EQ(inst.problem.lb[15], -kInf);
+  EXPECT_EQ(inst.problem.ub[15], kInf);
+  EXPECT_EQ(inst.problem.lb[12], inst.problem.ub[12]);  // swing foot f_z fixed
+}
+
+TEST(QpIo, WriterReproducesTheSharedFilesByteForByte) {
+  for (const char* f : {"wbc_01600.txt", "wbc_01750.txt", "wbc_01799.txt"}) {
+    const std::string text = slurp(sharedFile(f));
+    EXPECT_EQ(formatQpInstance(parseQpInstance(text, f)), text) << f;
+  }
+}
+
+TEST(QpIo, RoundTripThroughAFileIsBitExact) {
+  QpInstance a = readQpInstance(sharedFile("wbc_01700.txt"));
+  // Values %.6g would lose, infinities, and no optional records.
+  a.problem.g[0] = 0.1 + 0.2;
+  a.problem.beq[0] = -1e-300;
+  a.problem.lbA[3] = -kInf;
+  a.x_ref.reset();
+  a.step.reset();
+  const std::string path = (std::filesystem::temp_directory_path() / "mft_qp_roundtrip.txt").string();
+  writeQpInstance(path, a);
+  const QpInstance b = readQpInstance(path);
+  expectSame(a, b);
+  EXPECT_EQ(formatQpInstance(b), slurp(path));
+  std::filesystem::remove(path);
+  const QpInstance c = parseQpInstance(kSmall, "small");
+  expectSame(c, parseQpInstance(formatQpInstance(c), "again"));
+  EXPECT_EQ(c.problem.lb[1], 0.0);
+  EXPECT_EQ(c.problem.lbA[0], -kInf);
+}
+
+TEST(QpIo, RefusesMalformedFilesNamingThem) {
+  const std::string ok = kSmall;
+  auto replace = [&](const std::string& from, const std::string& to) {
+    std::string s = ok;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_NO_THROW(parseQpInstance(ok, "ok"));
+  const std::string msg = refusal(replace("ub 2", "wibble 3\nub 2"));
+  EXPECT_NE(msg.find("bad_file.txt"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("unknown record 'wibble'"), std::string::npos) << msg;
+  EXPECT_NE(refusal(replace("g 2\n1 -1", "g 3\n1 -1 2")).find("length 3"), std::string::npos);
+  EXPECT_NE(refusal(replace("H 2 2\n2 0\n0 1", "H 2 1\n2\n0")).find("cols"), std::string::npos);
+  EXPECT_NE(refusal(replace("end\n", "")).find("end"), std::string::npos);
+  EXPECT_NE(refusal(ok + "extra\n").find("after 'end'"), std::string::npos);
+  EXPECT_NE(refusal(replace("0.5", "0.5x")).find("0.5x"), std::string::npos);
+  EXPECT_NE(refusal(replace("0.5", "nan")).find("nan"), std::string::npos);
+  EXPECT_NE(refusal(replace("beq 1\n0.5\n", "")).find("missing record 'beq'"), std::string::npos);
+  EXPECT_NE(refusal(replace("WBCQP 1", "WBCQP 2")).find("version"), std::string::npos);
+  EXPECT_NE(refusal(replace("WBCQP 1", "QP 1")).find("WBCQP"), std::string::npos);
+  EXPECT_NE(refusal(replace("g 2\n1 -1\n", "g 2\n1 -1\ng 2\n1 -1\n")).find("duplicate"), std::string::npos);
+  EXPECT_FALSE(refusal(replace("ub 2\ninf inf\nend\n", "ub 2\ninf")).empty());  // truncated
+  EXPECT_FALSE(refusal(replace("dims 2 1 1\n", "")).empty());
+  try {
+    readQpInstance("/nonexistent/dir/missing.txt");
+    ADD_FAILURE();
+  } catch (const QpIoError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.txt"), std::string::npos);
+  }
+  EXPECT_THROW(listQpInstanceFiles("/nonexistent/dir"), QpIoError);
+}

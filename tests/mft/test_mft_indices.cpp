@@ -1,0 +1,143 @@
+// LTI (paper eq. 3-4): the closed forms of MFT-THEORY.md 1.3 against an independent screw-theory computation
+// (reciprocal products of the transmission wrench with the input and output twists, maxima by sampling force
+// directions), and singular configurations giving 0 without NaN.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "model/mft_criteria.hpp"
+#include "model/mft_indices.hpp"
+
+using namespace mft::model;
+
+namespace {
+
+// Planar screws in the (x, z) plane, CCW positive: twist (w; v at the origin), wrench (f; moment at the origin).
+struct Twist {
+  double w;
+  Eigen::Vector2d v;
+};
+struct Wrench {
+  Eigen::Vector2d f;
+  double m;
+};
+// Unit rotation about P: a point X moves with w * perp(X - P); at the origin v = perp(-P).
+Twist rotationAbout(const Eigen::Vector2d& P) { return {1.0, Eigen::Vector2d(P.y(), -P.x())}; }
+// Pure force of direction f on a line through Q.
+Wrench forceThrough(const Eigen::Vector2d& Q, const Eigen::Vector2d& f) { return {f, Q.x() * f.y() - Q.y() * f.x()}; }
+double reciprocal(const Wrench& W, const Twist& T) { return W.f.dot(T.v) + W.m * T.w; }
+
+// max over unit force directions through Q of |W o T|: sampled, then refined around the best angle.
+double maxPower(const Eigen::Vector2d& Q, const Twist& T) {
+  auto p = [&](double a) { return std::abs(reciprocal(forceThrough(Q, {std::cos(a), std::sin(a)}), T)); };
+  double best_a = 0.0, best = -1.0;
+  for (int i = 0; i < 720; ++i) {
+    const double a = M_PI * i / 720.0;
+    if (p(a) > best) best = p(a), best_a = a;
+  }
+  for (double h = M_PI / 720.0; h > 1e-12; h *= 0.5)
+    for (double a : {best_a - h, best_a + h})
+      if (p(a) > best) best = p(a), best_a = a;
+  return best;
+}
+
+const FiveBarGeometry kGeometries[] = {{0.0, 0.22, 0.26}, {0.06, 0.22, 0.26}, {0.0, 0.18, 0.33}, {0.04, 0.30, 0.25}};
+
+}  // namespace
+
+TEST(MftIndices, ClosedFormsMatchScrewTheory) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> q(-1.9, 1.9);
+  int checked = 0;
+  for (const auto& g : kGeometries) {
+    for (int n = 0; n < 400;) {
+      FiveBarPose p;
+      if (fiveBarForward(g, q(rng), q(rng), &p) != FiveBarStatus::Ok) continue;
+      ++n;
+      const Eigen::Vector2d A[2] = {g.hipRear(), g.hipFore()};
+      const Eigen::Vector2d B[2] = {p.knee_point_rear, p.knee_point_fore};
+      const Eigen::Vector2d C = p.foot;
+      double lambda[2], eta[2];
+      for (int i = 0; i < 2; ++i) {
+        const int j = 1 - i;
+        // Transmission wrench of chain i: a pure force along the shank (two passive revolutes), through C.
+        const Wrench T = forceThrough(C, (C - B[i]).normalized());
+        const Twist in = rotationAbout(A[i]);   // input twist: the actuated hip
+        const Twist out = rotationAbout(B[j]);  // output twist: other hip locked, foot turns about knee j
+        lambda[i] = std::abs(reciprocal(T, in)) / maxPower(B[i], in);
+        eta[i] = std::abs(reciprocal(T, out)) / maxPower(C, out);
+      }
+      const TransmissionIndices t = transmissionIndices(p);
+      EXPECT_NEAR(t.iti_rear, lambda[0], 1e-9);
+      EXPECT_NEAR(t.iti_fore, lambda[1], 1e-9);
+      EXPECT_NEAR(eta[0], eta[1], 1e-9);  // the OTI is the same for both chains
+      EXPECT_NEAR(t.oti, std::min(eta[0], eta[1]), 1e-9);
+      EXPECT_NEAR(t.lti(), std::min({lambda[0], lambda[1], eta[0], eta[1]}), 1e-9);
+      // Generalized-coordinate form: |sin q5|, |sin q7|, |sin(q6 + q7 - q4 - q5)|.
+      EXPECT_NEAR(t.iti_rear, std::abs(std::sin(p.knee_rear)), 1e-12);
+      EXPECT_NEAR(t.iti_fore, std::abs(std::sin(p.knee_fore)), 1e-12);
+      EXPECT_NEAR(t.oti, std::abs(std::sin(p.q_fore + p.knee_fore - p.q_rear - p.knee_rear)), 1e-12);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 1600);
+}
+
+TEST(MftIndices, OtiFromLockingOneHipMatchesTheClosedForm) {
+  // Lock the fore hip, drive the rear one: the foot velocity is perpendicular to the fore shank, and the
+  // power of the rear transmission force on it, over its maximum, is the OTI.
+  const FiveBarGeometry g = kGeometries[1];
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> q(-1.5, 1.5);
+  for (int n = 0; n < 200;) {
+    FiveBarPose p;
+    if (fiveBarForward(g, q(rng), q(rng), &p) != FiveBarStatus::Ok) continue;
+    ++n;
+    const Eigen::Vector2d v = fiveBarFootJacobian(g, p).col(0);
+    if (v.norm() < 1e-9) continue;
+    const Eigen::Vector2d f = (p.foot - p.knee_point_rear).normalized();
+    EXPECT_NEAR(std::abs(f.dot(v)) / v.norm(), transmissionIndices(p).oti, 1e-9);
+  }
+}
+
+TEST(MftIndices, SingularConfigurationsGiveZeroNotNaN) {
+  const FiveBarGeometry g = kGeometries[0];
+  TransmissionIndices t;
+  // Thighs coincide: degenerate loop, output singularity.
+  EXPECT_EQ(transmissionIndicesAt(g, 0.3, 0.3, &t), FiveBarStatus::Degenerate);
+  EXPECT_EQ(t.lti(), 0.0);
+  EXPECT_EQ(t.oti, 0.0);
+  // Unreachable and non-finite input: zeros.
+  EXPECT_EQ(transmissionIndicesAt(kGeometries[3], -1.5, 1.5, &t), FiveBarStatus::Unreachable);
+  EXPECT_EQ(t.lti(), 0.0);
+  EXPECT_EQ(transmissionIndicesAt(g, NAN, 0.1, &t), FiveBarStatus::Unreachable);
+  EXPECT_EQ(t.lti(), 0.0);
+  // Full stretch (knees straight) and full fold: input singularities.
+  for (double d : {g.l1 + g.l2, g.l2 - g.l1}) {
+    FiveBarPose p;
+    ASSERT_EQ(fiveBarInverse(g, {0.0, -d}, &p), FiveBarStatus::Ok);
+    t = transmissionIndices(p);
+    EXPECT_LT(t.lti(), 1e-6) << d;
+    EXPECT_FALSE(std::isnan(t.lti()));
+  }
+  // Near-singular values from the design notes: d = 0.48 - tiny and thighs 0.01 apart.
+  FiveBarPose p;
+  ASSERT_EQ(fiveBarForward(g, -0.005, 0.005, &p), FiveBarStatus::Ok);
+  EXPECT_NEAR(transmissionIndices(p).oti, 0.0085, 2e-4);
+}
+
+TEST(MftIndices, EveryIndexIsFiniteAndInRangeOverTheWholeBox) {
+  const FiveBarGeometry g = kGeometries[0];
+  for (double qr = -3.2; qr <= 3.2; qr += 0.05) {
+    for (double qf = -3.2; qf <= 3.2; qf += 0.05) {
+      TransmissionIndices t;
+      transmissionIndicesAt(g, qr, qf, &t);
+      for (double v : {t.iti_rear, t.iti_fore, t.oti, t.lti()}) {
+        ASSERT_TRUE(std::isfinite(v));
+        ASSERT_GE(v, 0.0);
+        ASSERT_LE(v, 1.0);
+      }
+    }
+  }
+}

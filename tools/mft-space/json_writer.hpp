@@ -1,0 +1,46 @@
+#pragma once
+// Minimal JSON output for --json (objects, arrays, numbers, strings). Non-finite numbers become null.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace mft::tools {
+
+inline std::string jsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+inline std::string jsonString(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\', o += c;
+    else if (c == '\n') o += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      o += buf;
+    } else o += c;
+  }
+  return o + "\"";
+}
+
+// Builds "{...}" from key/value pairs already rendered as JSON.
+class JsonObject {
+ public:
+  JsonObject& raw(const std::string& key, const std::string& json) {
+    body_ += (body_.empty() ? "" : ", ") + jsonString(key) + ": " + json;
+    return *this;
+  }
+  JsonObject& num(const std::string& key, double v) { return raw(key, jsonNumber(v)); }
+  JsonObject& str(const std::string& key, const std::string& v) { return raw(key, jsonString(v)); }
+  JsonObject& boolean(const std::string& key, bool v) { return raw(key, v ? "true" : "false"); }
+  std::string str() const { return "{" + body_ + "}"; }
+
+ private:
+  std::string body_;
+};
+
+}  // namespace mft::tools

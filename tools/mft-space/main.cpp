@@ -219,7 +219,7 @@ int cmdAll(int argc, char** argv) {
   } else {
     std::cout << summaryText(r) << "\n" << table << "\nwritten to " << dir << ": mft_space.yaml, "
               << (why.empty() ? "mft_space.png, " : "") << "stance.txt, stance.json, summary.json (total "
-              << progress.seconds() << " s)\n";
+              << static_cast<int>(progress.seconds() * 100.0 + 0.5) / 100.0 << " s)\n";
   }
   return 0;
 }

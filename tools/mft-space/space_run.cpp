@@ -11,6 +11,16 @@ namespace mft::tools {
 
 using namespace mft::model;
 
+namespace {
+// %g, or fixed with `decimals` digits.
+std::string num(double v, int decimals = -1) {
+  char buf[40];
+  if (decimals < 0) std::snprintf(buf, sizeof buf, "%g", v);
+  else std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+}  // namespace
+
 const char* const kSpaceOptions[] = {"joint-step", "cart-step", "edges", "starts", "seed", "lti-min", "lti-max",
                                      "raci-min", "raci-max", "accel", "raci-form", "drive-k", nullptr};
 
@@ -46,9 +56,9 @@ SpaceSettings settingsFromArgs(const CliArgs& a, const RobotDescription& robot) 
 void gridSpaces(const RobotDescription& robot, const MftCriteria& c, double joint_step, double cart_step,
                 Progress& progress, LabelGrid* joint, LabelGrid* cartesian) {
   const MftLegModel leg = MftLegModel::from(robot);
-  progress.stage("gridding actuated joint space, step " + std::to_string(joint_step) + " rad");
+  progress.stage("gridding actuated joint space, step " + num(joint_step) + " rad");
   *joint = gridJointSpace(leg, c, joint_step, [&](int d, int t) { progress.percent("joint grid", d, t); });
-  progress.stage("gridding Cartesian foot space, step " + std::to_string(cart_step) + " m");
+  progress.stage("gridding Cartesian foot space, step " + num(cart_step) + " m");
   *cartesian = gridCartesianSpace(leg, c, cart_step, [&](int d, int t) { progress.percent("Cartesian grid", d, t); });
 }
 
@@ -97,8 +107,9 @@ SpaceResult runSpace(const RobotDescription& robot, const SpaceSettings& s, Prog
   p.fit.reachable_cells = r.joint.countAtLeast(kCellReachable);
   r.has_augmented = s.edges == kMftLegEdges;
   if (r.has_augmented) buildAugmented(p.leg, &p);
-  progress.stage("fit done: area " + std::to_string(r.fit.area) + " rad^2, coverage " +
-                 std::to_string(100.0 * r.quality.coverage) + " %");
+  progress.stage("fit done: area " + num(r.fit.area, 4) + " rad^2, coverage " +
+                 num(100.0 * r.quality.coverage, 2) + " %, " + std::to_string(r.quality.bad_inside) +
+                 " bad cells inside, r " + num(r.quality.r_max, 5) + " rad");
   return r;
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "model/robot_description.hpp"
 #include "planner/foot_placement.hpp"
@@ -133,6 +134,8 @@ TEST(MotionPlanner, WalkingReachesASteadyForwardSpeed) {
     if (i == 5000) x_at_5s = r.x;
   }
   const double v_avg = (r.x - x_at_5s) / 3.0;
+  std::printf("walk at v_cmd 0.3 m/s: average speed %.3f m/s, %llu steps\n", v_avg,
+              static_cast<unsigned long long>(planner.output().step_index));
   // Eq. 13 with the paper's gains is a P law: with k_v != 1/sigma1 it settles below the command
   // (v = k_p v* / (k_v + k_p - 1/sigma1) for the pre-impact speed, about 0.85 v* here).
   EXPECT_GT(v_avg, 0.6 * 0.3);

@@ -9,19 +9,16 @@ namespace {
 
 constexpr double kNoStep = std::numeric_limits<double>::infinity();
 
-// Replaces columns (a, b) by (c a + s b, c b - s a): the rotation that moves J' n's weight into column a.
-inline void rotatePair(double* a, double* b, int len, double c, double s) {
-  for (int k = 0; k < len; ++k) {
-    const double ta = a[k], tb = b[k];
-    a[k] = c * ta + s * tb;
-    b[k] = c * tb - s * ta;
-  }
-}
-
 bool noNaN(const Eigen::VectorXd& v) {
   for (Eigen::Index i = 0; i < v.size(); ++i)
     if (std::isnan(v[i])) return false;
   return true;
+}
+
+// All entries finite: x * 0 is 0 for finite x and NaN otherwise; the sum vectorizes without branches.
+template <class M>
+bool allFinite(const M& m) {
+  return (m.array() * 0.0).sum() == 0.0;
 }
 
 }  // namespace
@@ -38,8 +35,10 @@ void GoldfarbIdnaniSolver::resize(int n, int neq, int nin) {
   L_.setZero(n, n);
   J_.setZero(n, n);
   R_.setZero(n, n);
-  for (Eigen::VectorXd* v : {&x_, &x_unc_, &d_, &z_, &r_, &u_, &w_, &np_}) v->setZero(n);
+  for (Eigen::VectorXd* v : {&x_, &x_unc_, &d_, &r_, &u_, &w_, &np_}) v->setZero(n);
   row_values_.setZero(nin);
+  lo_.assign(n, 0);
+  hi_.assign(n, 0);
   const int m_cap = neq + 2 * n + 2 * nin;
   kind_.assign(m_cap, kEqRow);
   index_.assign(m_cap, 0);
@@ -83,7 +82,7 @@ QpStatus GoldfarbIdnaniSolver::checkData(const QpProblem& p) const {
       p.beq.size() != p.neq || p.Ain.rows() != p.nin || p.Ain.cols() != n || p.lbA.size() != p.nin ||
       p.ubA.size() != p.nin || p.lb.size() != n || p.ub.size() != n)
     return QpStatus::NumericalFailure;
-  if (!p.H.allFinite() || !p.g.allFinite() || !p.Aeq.allFinite() || !p.beq.allFinite() || !p.Ain.allFinite())
+  if (!allFinite(p.H) || !allFinite(p.g) || !allFinite(p.Aeq) || !allFinite(p.beq) || !allFinite(p.Ain))
     return QpStatus::NumericalFailure;
   if (!noNaN(p.lb) || !noNaN(p.ub) || !noNaN(p.lbA) || !noNaN(p.ubA)) return QpStatus::NumericalFailure;
   for (int j = 0; j < n; ++j)
@@ -135,6 +134,10 @@ bool GoldfarbIdnaniSolver::factorize(const QpProblem& p) {
     if (!(H(j, j) > 0.0)) return false;
     J_(j, j) = 1.0 / std::sqrt(H(j, j));
   }
+  for (int j = 0; j < n; ++j) {
+    lo_[j] = j < nb ? 0 : j;
+    hi_[j] = j + 1;
+  }
 
   // Unconstrained minimizer x_unc = -J J' g (the sign matters: eiquadprog's provided-factor path misses it).
   for (int j = 0; j < nb; ++j) w_[j] = J_.col(j).head(j + 1).dot(p.g.head(j + 1));
@@ -185,7 +188,27 @@ void GoldfarbIdnaniSolver::computeD(const QpProblem& p, int c) {
   }
   const Eigen::MatrixXd& A = kind_[c] == kEqRow ? p.Aeq : p.Ain;
   np_.noalias() = sign * A.row(idx).transpose();
-  d_.noalias() = J_.transpose() * np_;
+  const double* nv = np_.data();
+  for (int j = 0; j < n_; ++j) {
+    const double* Jj = &J_(0, j);
+    double v = 0.0;
+    for (int k = lo_[j]; k < hi_[j]; ++k) v += Jj[k] * nv[k];
+    d_[j] = v;
+  }
+}
+
+void GoldfarbIdnaniSolver::rotateColumns(int a, int b, double c, double s) {
+  // Only the union of the two columns' nonzero row ranges changes; entries outside stay exactly zero.
+  const int lo = std::min(lo_[a], lo_[b]), hi = std::max(hi_[a], hi_[b]);
+  lo_[a] = lo_[b] = lo;
+  hi_[a] = hi_[b] = hi;
+  double* A = &J_(0, a);
+  double* B = &J_(0, b);
+  for (int k = lo; k < hi; ++k) {
+    const double ta = A[k], tb = B[k];
+    A[k] = c * ta + s * tb;
+    B[k] = c * tb - s * ta;
+  }
 }
 
 double GoldfarbIdnaniSolver::slack(const QpProblem& p, int c) const {
@@ -208,16 +231,17 @@ bool GoldfarbIdnaniSolver::isDependent() const {
 
 void GoldfarbIdnaniSolver::addToFactor(int c) {
   // Rotate d = J'n so that only its first q+1 entries are nonzero; R gets d[0..q] as its new column.
-  const int n = n_;
-  for (int i = n - 1; i > q_; --i) {
+  // Each nonzero d[i] is rotated straight into d[q]: columns with d[i] == 0 (e.g. the eps columns a row does
+  // not touch) are left alone, which a chain of adjacent rotations would not do.
+  const int q = q_;
+  for (int i = q + 1; i < n_; ++i) {
     const double b = d_[i];
     if (b == 0.0) continue;
-    const double a = d_[i - 1];
+    const double a = d_[q];
     const double h = std::sqrt(a * a + b * b);
-    const double cs = a / h, sn = b / h;
-    d_[i - 1] = h;
+    d_[q] = h;
     d_[i] = 0.0;
-    rotatePair(&J_(0, i - 1), &J_(0, i), n, cs, sn);
+    rotateColumns(q, i, a / h, b / h);
   }
   R_.col(q_).head(q_ + 1) = d_.head(q_ + 1);
   active_[q_] = c;
@@ -246,7 +270,7 @@ void GoldfarbIdnaniSolver::dropFromFactor(int pos) {
       R_(j, l) = cs * ta + sn * tb;
       R_(j + 1, l) = cs * tb - sn * ta;
     }
-    rotatePair(&J_(0, j), &J_(0, j + 1), n_, cs, sn);
+    rotateColumns(j, j + 1, cs, sn);
   }
 }
 
@@ -267,7 +291,11 @@ void GoldfarbIdnaniSolver::primalDualFromFactor(const QpProblem& p) {
     w_[j] = e / Rj[j];
   }
   x_ = x_unc_;
-  if (q > 0) x_.noalias() += J_.leftCols(q) * w_.head(q);
+  for (int j = 0; j < q; ++j) {
+    const double* Jj = &J_(0, j);
+    const double wj = w_[j];
+    for (int k = lo_[j]; k < hi_[j]; ++k) x_[k] += wj * Jj[k];
+  }
   for (int j = q - 1; j >= 0; --j) {
     double v = w_[j];
     for (int k = j + 1; k < q; ++k) v -= R_(j, k) * u_[k];
@@ -362,8 +390,12 @@ QpStatus GoldfarbIdnaniSolver::solveOnce(const QpProblem& p, bool warm) {
       const double t = std::min(t1, t2);
       if (t2 != kNoStep) {
         // Primal step along z = J2 J2' n_p.
-        z_.noalias() = J_.rightCols(n_ - q) * d_.tail(n_ - q);
-        x_.noalias() += t * z_;
+        for (int j = q; j < n_; ++j) {
+          const double* Jj = &J_(0, j);
+          const double step = t * d_[j];
+          if (step == 0.0) continue;
+          for (int k = lo_[j]; k < hi_[j]; ++k) x_[k] += step * Jj[k];
+        }
         sp += t * d2sq;
       }
       for (int j = 0; j < q; ++j) u_[j] -= t * r_[j];

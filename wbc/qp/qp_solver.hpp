@@ -62,6 +62,7 @@ class GoldfarbIdnaniSolver {
   void buildConstraints(const QpProblem& p);
   void computeD(const QpProblem& p, int c);  // d = J' n_c
   double slack(const QpProblem& p, int c) const;
+  void rotateColumns(int a, int b, double c, double s);  // Givens rotation of J columns a, b
   void addToFactor(int c);                   // uses d_; appends c to the active set
   void dropFromFactor(int pos);              // removes active position pos
   void primalDualFromFactor(const QpProblem& p);  // x, u for the active set taken as equalities
@@ -76,7 +77,8 @@ class GoldfarbIdnaniSolver {
   Eigen::MatrixXd L_;  // Cholesky factor of the dense block
   Eigen::MatrixXd J_;  // n x n, J J' = H^-1, columns [active range | rest]
   Eigen::MatrixXd R_;  // upper triangular, q x q used
-  Eigen::VectorXd x_, x_unc_, d_, z_, r_, u_, w_, np_, row_values_;
+  std::vector<int> lo_, hi_;  // rows [lo, hi) of each J column that may be nonzero (block structure)
+  Eigen::VectorXd x_, x_unc_, d_, r_, u_, w_, np_, row_values_;
 
   // Internal one-sided constraints n'x >= b: the always-active ones first, then the inequalities.
   std::vector<Kind> kind_;

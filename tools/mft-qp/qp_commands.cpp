@@ -107,6 +107,14 @@ std::string num(double v) {
   return buf;
 }
 
+// Full precision for solution values (round-trips like the instance files).
+std::string numExact(double v) {
+  if (!std::isfinite(v)) return num(v);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
 std::string jsonString(const std::string& s) {
   std::string out = "\"";
   for (char c : s) {
@@ -215,14 +223,14 @@ int runSolve(const SolveOptions& o) {
   if (o.json) {
     std::cout << "{\"file\": " << jsonString(o.file) << ", \"name\": " << jsonString(inst.name)
               << ", \"status\": " << jsonString(qp::toString(st)) << ", \"iterations\": " << sol.iterations
-              << ", \"objective\": " << num(sol.objective)
-              << ", \"f_ref\": " << (inst.f_ref ? num(*inst.f_ref) : "null")
+              << ", \"objective\": " << numExact(sol.objective)
+              << ", \"f_ref\": " << (inst.f_ref ? numExact(*inst.f_ref) : "null")
               << ", \"max_x_err\": " << (inst.x_ref ? num(a.x_err) : "null")
               << ", \"kkt\": {\"stationarity\": " << num(kkt.stationarity) << ", \"primal\": " << num(kkt.primal)
               << ", \"dual\": " << num(kkt.dual) << ", \"complementarity\": " << num(kkt.complementarity) << "}"
               << ", \"active_mismatch\": " << (inst.active_ref ? std::to_string(a.mismatched) : "null")
               << ", \"active\": " << jsonString(active.str()) << ", \"solve_us\": " << num(us) << ", \"x\": [";
-    for (int j = 0; j < p.n; ++j) std::cout << (j ? ", " : "") << num(sol.x[j]);
+    for (int j = 0; j < p.n; ++j) std::cout << (j ? ", " : "") << numExact(sol.x[j]);
     std::cout << "]}\n";
   } else {
     std::printf("instance        %s (%s)\n", inst.name.c_str(), o.file.c_str());

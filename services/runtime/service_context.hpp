@@ -1,0 +1,51 @@
+#pragma once
+// What every service main starts with: the common options of the service contract (see
+// services/mft-supervisor), the robot description, the scenario, the DDS participant, the QoS profile names
+// of the chosen loop mode, and the JSON summary written at exit.
+#include <memory>
+#include <string>
+
+#include "model/robot_description.hpp"
+#include "services/runtime/dds_participant.hpp"
+#include "services/runtime/process.hpp"
+#include "services/runtime/scenario.hpp"
+
+namespace mft::services {
+
+enum class LoopMode { Lockstep, Realtime };
+
+class ServiceContext {
+ public:
+  // Declares the common options on `cli`; call before cli.parse().
+  static void declareOptions(CommandLine& cli);
+  // After cli.parse(): loads the configuration and creates the participant. Exits 2 with a clear message on
+  // any configuration error (nothing is started).
+  ServiceContext(const std::string& service, const CommandLine& cli);
+
+  const std::string& service() const { return service_; }
+  LoopMode mode() const { return mode_; }
+  bool lockstep() const { return mode_ == LoopMode::Lockstep; }
+  const model::RobotDescription& robot() const { return robot_; }
+  const Scenario& scenario() const { return scenario_; }
+  std::string configFile(const std::string& name) const { return config_dir_ + "/" + name; }
+  DdsParticipant& participant() { return *participant_; }
+
+  // QoS profiles of the 1 kHz chain: reliable in lockstep (every tick must arrive), deadline-watched
+  // best effort in realtime.
+  std::string chainWriterProfile() const { return lockstep() ? "reliable_writer" : "control_writer"; }
+  std::string chainReaderProfile() const { return lockstep() ? "reliable_reader" : "control_reader"; }
+
+  // Writes `json` (an object) to the --summary file, if one was given. Never throws.
+  void writeSummary(const std::string& json) const;
+
+ private:
+  std::string service_;
+  LoopMode mode_ = LoopMode::Lockstep;
+  std::string config_dir_;
+  std::string summary_file_;
+  model::RobotDescription robot_;
+  Scenario scenario_;
+  std::unique_ptr<DdsParticipant> participant_;
+};
+
+}  // namespace mft::services

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
+#include <stdexcept>
 
 #include "wbc/leg_indices.hpp"
 #include "wbc/wbc_assembly.hpp"
@@ -23,14 +25,38 @@ bool modelFinite(const model::ModelData& d) {
          d.Jh_dot_qd.allFinite() && d.foot_pos.allFinite() && d.foot_vel.allFinite();
 }
 
+WbcPolytope fromMftPolytope(const model::MftPolytope& p, const model::RobotDescription& robot) {
+  if (p.robot_checksum != robot.checksum)
+    throw std::invalid_argument("WBC: the MFT polytope " + p.source_file + " was made for robot description " +
+                                model::checksumHex(p.robot_checksum) + ", not " + model::checksumHex(robot.checksum));
+  WbcPolytope w;
+  w.A = p.A;
+  w.b = p.b;
+  return w;
+}
+
 }  // namespace
 
 WholeBodyController::WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config,
-                                         const WbcPolytope* polytope)
+                                         const model::MftPolytope* polytope)
+    : WholeBodyController(robot, config, polytope ? std::optional<WbcPolytope>(fromMftPolytope(*polytope, robot)) : std::nullopt,
+                          polytope ? polytope->criteria.raci_options : model::MftCriteria::defaults(robot).raci_options) {}
+
+WholeBodyController::WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config,
+                                         const WbcPolytope& polytope)
+    : WholeBodyController(robot, config, std::optional<WbcPolytope>(polytope),
+                          model::MftCriteria::defaults(robot).raci_options) {}
+
+WholeBodyController::WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config,
+                                         const std::optional<WbcPolytope>& polytope,
+                                         const model::RaciOptions& raci_options)
     : model_(model::buildBipedModel(robot)),
-      params_(makeWbcParams(robot, config, polytope)),
-      has_polytope_(polytope != nullptr),
+      params_(makeWbcParams(robot, config, polytope ? &*polytope : nullptr)),
+      has_polytope_(polytope.has_value()),
       total_mass_(robot.totalMass()),
+      leg_geometry_(model::FiveBarGeometry::from(robot)),
+      leg_inertia_(model::LegInertiaParams::from(robot)),
+      raci_options_(raci_options),
       formulation_(buildFormulation(params_)),
       safety_(config.safety.hold_ticks, config.safety.damping_Nms_per_rad, params_.tau_max,
               config.safety.latch_damping) {
@@ -69,7 +95,14 @@ void WholeBodyController::fillStateDiagnostics(const model::RobotStateEstimate& 
   diag->safety = safety_.counters();
   diag->num_tasks = static_cast<int>(formulation_.tasks.size());
   if (!state.q.allFinite()) return;
-  for (int leg = 0; leg < model::kNumLegs; ++leg) diag->lti[leg] = legLti(state.q, leg);
+  for (int leg = 0; leg < model::kNumLegs; ++leg) {
+    diag->lti[leg] = legLti(state.q, leg);
+    // RACI depends on the hip angles only (MFT-THEORY.md 2.3); +inf at a singularity, NaN if unreachable.
+    model::FiveBarPose pose;
+    if (model::fiveBarForward(leg_geometry_, state.q[model::hipRearIndex(leg)], state.q[model::hipForeIndex(leg)],
+                              &pose) == model::FiveBarStatus::Ok)
+      diag->raci[leg] = model::computeRaci(leg_geometry_, leg_inertia_, pose, raci_options_).raci;
+  }
   model::VectorA q_a;
   for (int i = 0; i < model::kNa; ++i) q_a[i] = state.q[model::kActuatedIndex[i]];
   diag->mft_violation = polytopeViolation(q_a);

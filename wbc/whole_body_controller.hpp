@@ -3,13 +3,17 @@
 // torques by the closed-loop inverse dynamics (eq. 7), and a safety stage. One update() per control tick;
 // everything is sized at construction and nothing is allocated per tick.
 //
+//   const MftPolytope polytope = model::loadMftPolytope("config/mft_space.yaml", robot);
 //   WholeBodyController wbc(robot, loadWbcConfig("config/wbc.yaml"), &polytope);
 //   WbcDiagnostics diag;
 //   ActuatorCommand cmd = wbc.update(state_estimate, reference, &diag);
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "model/mft_criteria.hpp"
+#include "model/mft_polytope.hpp"
 #include "model/planar_dynamics.hpp"
 #include "model/robot_description.hpp"
 #include "model/robot_io.hpp"
@@ -26,10 +30,14 @@ namespace mft::wbc {
 
 class WholeBodyController {
  public:
-  // polytope: the MFT preferable polytope (required for variant mft, optional otherwise: then only used for
-  // diagnostics). Throws mft::config::ConfigError for a config that does not fit the robot and
-  // std::invalid_argument for a missing polytope.
-  WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config, const WbcPolytope* polytope);
+  // polytope: the MFT preferable polytope of config/mft_space.yaml (required for variant mft, optional
+  // otherwise: then only used for diagnostics; its RACI settings are used for the RACI diagnostics). Throws
+  // mft::config::ConfigError for a config that does not fit the robot and std::invalid_argument for a missing
+  // polytope or one made for another robot description.
+  WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config,
+                      const model::MftPolytope* polytope = nullptr);
+  // Same with a bare A q_a <= b (tests, studies): no checksum to check; RACI settings from the robot.
+  WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config, const WbcPolytope& polytope);
 
   // One control tick. Never throws and never returns non-finite torques: a failure goes to the safety stage.
   // diag may be null.
@@ -63,6 +71,8 @@ class WholeBodyController {
   void writeLastQp(const std::string& path) const;
 
  private:
+  WholeBodyController(const model::RobotDescription& robot, const WbcConfig& config,
+                      const std::optional<WbcPolytope>& polytope, const model::RaciOptions& raci_options);
   model::ActuatorCommand fail(SafetyEvent cause, const model::RobotStateEstimate& state, WbcDiagnostics* diag);
   void fillStateDiagnostics(const model::RobotStateEstimate& state, const WbcReference& ref, bool model_valid,
                             WbcDiagnostics* diag) const;
@@ -72,6 +82,9 @@ class WholeBodyController {
   WbcParams params_;
   bool has_polytope_ = false;
   double total_mass_ = 0.0;
+  model::FiveBarGeometry leg_geometry_;
+  model::LegInertiaParams leg_inertia_;
+  model::RaciOptions raci_options_;
   Formulation formulation_;
   VariableBounds bounds_;
   model::ModelData data_;

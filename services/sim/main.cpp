@@ -1,0 +1,273 @@
+// mft-sim: the ODE simulator as a service. It owns the clock (ARCHITECTURE.md section 3):
+//  lockstep: publish GroundTruth(k) and SensorData(k), wait for JointCommand(k), step; deterministic, as fast
+//            as the chain answers; a missing answer is a named timeout error (exit status 3).
+//  realtime: step on the wall clock at 1 kHz (absolute deadlines), apply the latest command (zero-order hold);
+//            the command watchdog puts the actuators into damping when commands stop, and back when they resume.
+// It plays the scenario's pushes (and Disturbance messages from mft-cmd), ends the run at the scenario's
+// duration (or at a fall), and writes the run summary.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+
+#include "MftMsgsPubSubTypes.h"
+#include "model/config/strict_yaml.hpp"
+#include "services/runtime/command_watchdog.hpp"
+#include "services/runtime/convert.hpp"
+#include "services/runtime/latency_stats.hpp"
+#include "services/runtime/run_monitor.hpp"
+#include "services/runtime/service_context.hpp"
+#include "services/runtime/topic_io.hpp"
+#include "sim/simulator.hpp"
+
+using namespace mft;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+std::int64_t nowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+// `mft-sim --check-scenario FILE [--json]`: validates a scenario and everything it names, starts nothing.
+int checkScenario(int argc, char** argv) {
+  services::CommandLine cli("mft-sim --check-scenario", "Validate a scenario file (and its terrain) and exit.");
+  cli.option("check-scenario", "the scenario file", "", true);
+  cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.flag("json", "print the scenario as JSON");
+  cli.parse(argc, argv);
+  try {
+    const auto robot = model::loadRobotDescription(cli.get("config-dir") + "/robot.yaml");
+    const auto scenario = services::loadScenario(cli.get("check-scenario"));
+    sim::loadTerrain(cli.get("config-dir") + "/terrain/" + scenario.terrain + ".yaml");
+    sim::loadSimOptions(cli.get("config-dir") + "/sim.yaml");
+    (void)robot;
+    if (cli.isSet("json")) std::printf("%s\n", scenario.toJson().c_str());
+    else std::printf("%s: scenario '%s' is valid (%.3f s, controller %s)\n", scenario.source_file.c_str(),
+                     scenario.name.c_str(), scenario.duration_s, scenario.controller.c_str());
+  } catch (const config::ConfigError& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
+
+// The height command in force at time t (for the height-error statistics).
+double commandedHeight(const services::Scenario& s, double t) {
+  double z = s.commands.front().z_cmd_m;
+  for (const auto& c : s.commands)
+    if (c.at_s <= t) z = c.z_cmd_m;
+  return z;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--check-scenario" || std::string(argv[i]).rfind("--check-scenario=", 0) == 0)
+      return checkScenario(argc, argv);
+
+  services::CommandLine cli("mft-sim",
+                            "ODE simulator service: owns the clock; JointCommand -> SensorData, GroundTruth.\n"
+                            "Also: mft-sim --check-scenario FILE [--json] validates a scenario and exits.");
+  services::ServiceContext::declareOptions(cli);
+  cli.flag("forever", "ignore the scenario's duration: run until stopped");
+  cli.flag("continue-after-fall", "keep running after a fall (default: the run ends at the fall)");
+  cli.option("command-timeout", "lockstep: seconds to wait for each JointCommand", "5");
+  cli.option("start-timeout", "seconds to wait for the controller chain to connect and answer", "30");
+  cli.option("watchdog-ms", "realtime: command timeout before the actuators damp [ms]", "3");
+  cli.flag("quiet", "no progress lines");
+  cli.parse(argc, argv);
+  services::installShutdownHandlers();
+  services::ServiceContext ctx("mft-sim", cli);
+  const auto& scenario = ctx.scenario();
+
+  sim::SimOptions options;
+  sim::Terrain terrain;
+  try {
+    options = sim::loadSimOptions(ctx.configFile("sim.yaml"));
+    terrain = sim::loadTerrain(ctx.configFile("terrain/" + scenario.terrain + ".yaml"));
+  } catch (const config::ConfigError& e) {
+    cli.fail(e.what());
+  }
+  sim::Simulator simulator(ctx.robot(), options, terrain);
+  sim::StandingPose pose;
+  pose.base_height_m = scenario.initial_base_height_m;
+  simulator.reset(pose);
+  for (const auto& p : scenario.pushes) {
+    sim::ImpulseSpec spec;
+    spec.impulse_Ns = {p.impulse_Ns, 0.0};
+    spec.time_s = p.at_s;
+    spec.trigger = p.at_liftoff_leg < 0 ? sim::ImpulseTrigger::AtTime : sim::ImpulseTrigger::AtLiftOff;
+    spec.leg = std::max(0, p.at_liftoff_leg);
+    simulator.scheduleImpulse(spec);
+  }
+
+  const double command_timeout_s = cli.getDouble("command-timeout", 0.01, 3600);
+  const double start_timeout_s = cli.getDouble("start-timeout", 0.1, 3600);
+  services::CommandWatchdog watchdog(static_cast<std::int64_t>(cli.getDouble("watchdog-ms", 1, 10000) * 1e6));
+  const bool quiet = cli.isSet("quiet");
+
+  // Commands arrive on a DDS thread; the loop below owns the simulator.
+  std::mutex mutex;
+  std::condition_variable arrived;
+  model::ActuatorCommand latest;
+  bool have_command = false;
+  std::vector<sim::ImpulseSpec> pending_pushes;
+  std::array<std::int64_t, 1024> publish_ns{};  // when SensorData(k) left, by k % 1024 (realtime latency)
+  services::LatencyStats latency_us;
+  std::uint64_t published_tick = 0;
+
+  services::TopicWriter<msg::SensorData, msg::SensorDataPubSubType> sensor_writer(ctx.participant(), "SensorData",
+                                                                                  ctx.chainWriterProfile());
+  services::TopicWriter<msg::GroundTruth, msg::GroundTruthPubSubType> truth_writer(ctx.participant(), "GroundTruth",
+                                                                                   ctx.chainWriterProfile());
+  services::TopicReader<msg::JointCommand, msg::JointCommandPubSubType> command_reader(
+      ctx.participant(), "JointCommand", ctx.chainReaderProfile(), [&](const msg::JointCommand& m) {
+        const std::int64_t t = nowNs();
+        std::lock_guard<std::mutex> lock(mutex);
+        services::fromMsg(m, &latest);
+        have_command = true;
+        watchdog.onCommand(m.seq(), t);
+        if (!ctx.lockstep() && m.tick() == published_tick)
+          latency_us.add(static_cast<double>(t - publish_ns[m.tick() % publish_ns.size()]) * 1e-3);
+        arrived.notify_all();
+      });
+  services::TopicReader<msg::Disturbance, msg::DisturbancePubSubType> push_reader(
+      ctx.participant(), "Disturbance", "event_reader", [&](const msg::Disturbance& m) {
+        sim::ImpulseSpec spec;
+        spec.impulse_Ns = {m.impulse_Ns(), 0.0};
+        spec.time_s = m.time_s();
+        spec.trigger = m.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF ? sim::ImpulseTrigger::AtLiftOff
+                                                                    : sim::ImpulseTrigger::AtTime;
+        spec.leg = std::max<int>(0, m.leg());
+        std::lock_guard<std::mutex> lock(mutex);
+        pending_pushes.push_back(spec);
+      });
+  services::announceReady("mft-sim");
+
+  msg::SensorData sensor_msg;
+  msg::GroundTruth truth_msg;
+  auto publish = [&] {
+    services::toMsg(simulator.groundTruth(), &truth_msg);
+    services::toMsg(simulator.sensors(), &sensor_msg);
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      published_tick = simulator.tick();
+      publish_ns[published_tick % publish_ns.size()] = nowNs();
+    }
+    truth_writer.write(truth_msg);
+    sensor_writer.write(sensor_msg);
+  };
+
+  // Readiness of the chain: the estimator listens and the controller's command writer is there.
+  const auto start_deadline = Clock::now() + std::chrono::duration<double>(start_timeout_s);
+  if (!services::waitUntil([&] { return sensor_writer.matched() > 0 && truth_writer.matched() > 0 && command_reader.matched() > 0; },
+                           std::chrono::duration_cast<std::chrono::milliseconds>(start_deadline - Clock::now()))) {
+    std::fprintf(stderr, "mft-sim: the controller chain did not connect within %.0f s (SensorData readers %d, "
+                         "JointCommand writers %d)\n", start_timeout_s, sensor_writer.matched(), command_reader.matched());
+    return 3;
+  }
+
+  services::FallCriteria criteria;
+  criteria.base_height_below_m = scenario.fall_base_height_m;
+  criteria.pitch_beyond_rad = scenario.fall_pitch_rad;
+  services::RunMonitor monitor(criteria, 1.0);
+  const bool forever = cli.isSet("forever");
+  const auto ticks_total = static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s));
+  std::uint64_t damping_ticks = 0, last_progress_tick = 0;
+  int exit_code = 0;
+  std::string error;
+  const auto wall_start = Clock::now();
+  auto next_wakeup = wall_start;
+  const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.control_period_s));
+
+  while (!services::shutdownRequested() && (forever || simulator.tick() < ticks_total)) {
+    const std::uint64_t k = simulator.tick();
+    publish();
+    model::ActuatorCommand command;
+    if (ctx.lockstep()) {
+      // Wait for JointCommand(k). Until the chain has answered once, re-send tick k now and then: samples
+      // written just after matching can be lost (DDS.md G13) and every service answers a repeated tick.
+      std::unique_lock<std::mutex> lock(mutex);
+      const auto deadline = Clock::now() + std::chrono::duration<double>(k == 0 ? start_timeout_s : command_timeout_s);
+      while (!(have_command && latest.tick == k) && !services::shutdownRequested()) {
+        if (Clock::now() > deadline) break;
+        if (arrived.wait_for(lock, std::chrono::milliseconds(k == 0 ? 100 : 50)) == std::cv_status::timeout && k == 0) {
+          lock.unlock();
+          publish();
+          lock.lock();
+        }
+      }
+      if (services::shutdownRequested()) break;
+      if (!(have_command && latest.tick == k)) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "timeout: no JointCommand for tick %llu within %.1f s (is mft-wbc running?)",
+                      static_cast<unsigned long long>(k), k == 0 ? start_timeout_s : command_timeout_s);
+        error = buf;
+        exit_code = 3;
+        break;
+      }
+      command = latest;
+    } else {
+      next_wakeup += period;
+      std::this_thread::sleep_until(next_wakeup);
+      std::lock_guard<std::mutex> lock(mutex);
+      command = latest;  // zero-order hold of the newest command
+      if (!have_command || watchdog.damping(nowNs())) {
+        command.mode = model::CommandMode::Damping;
+        ++damping_ticks;
+      }
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      for (const auto& p : pending_pushes) simulator.scheduleImpulse(p);
+      pending_pushes.clear();
+    }
+    simulator.setCommand(command);
+    simulator.step();
+    const bool fell_now = monitor.update(simulator.groundTruth(), commandedHeight(scenario, simulator.time()),
+                                         simulator.stats().body_contact_steps);
+    if (fell_now) {
+      std::printf("mft-sim: FELL at t = %.3f s: %s\n", monitor.fallTime(), monitor.fallReason().c_str());
+      std::fflush(stdout);
+      if (!cli.isSet("continue-after-fall")) break;
+    }
+    if (!quiet && simulator.tick() - last_progress_tick >= 1000) {
+      last_progress_tick = simulator.tick();
+      const double wall = std::chrono::duration<double>(Clock::now() - wall_start).count();
+      std::printf("mft-sim: t = %.1f s, %.2fx real time, base z %.4f m\n", simulator.time(),
+                  simulator.time() / std::max(wall, 1e-9), simulator.groundTruth().q[1]);
+      std::fflush(stdout);
+    }
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  if (!error.empty()) std::fprintf(stderr, "mft-sim: %s\n", error.c_str());
+
+  const auto& stats = simulator.stats();
+  char buf[1600];
+  std::snprintf(
+      buf, sizeof buf,
+      "{\"service\": \"mft-sim\", \"scenario\": \"%s\", \"mode\": \"%s\", \"fell\": %s, \"fall_time_s\": %.4f, "
+      "\"fall_reason\": \"%s\", \"ticks\": %llu, \"sim_time_s\": %.4f, \"wall_time_s\": %.3f, "
+      "\"real_time_factor\": %.3f, \"deadline_misses\": %llu, \"lost_commands\": %llu, \"damping_ticks\": %llu, "
+      "\"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
+      "\"base_height_error_m\": {\"rms\": %.6f, \"max\": %.6f}, \"pitch_error_rad\": {\"rms\": %.6f, \"max\": %.6f}, "
+      "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
+      "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", ",
+      scenario.name.c_str(), ctx.lockstep() ? "lockstep" : "realtime", monitor.fell() ? "true" : "false",
+      monitor.fallTime(), monitor.fallReason().c_str(), static_cast<unsigned long long>(simulator.tick()),
+      simulator.time(), wall_s, simulator.time() / std::max(wall_s, 1e-9),
+      static_cast<unsigned long long>(watchdog.deadlineMisses()), static_cast<unsigned long long>(watchdog.lostCommands()),
+      static_cast<unsigned long long>(damping_ticks), static_cast<unsigned long long>(watchdog.recoveries()),
+      static_cast<unsigned long long>(command_reader.requestedDeadlineMisses()), monitor.heightError().rms(),
+      monitor.heightError().max_abs, monitor.pitchError().rms(), monitor.pitchError().max_abs, monitor.averageSpeed(),
+      monitor.distance(), simulator.groundTruth().q[1], stats.impulses.size(), stats.max_closure_error_m,
+      static_cast<unsigned long long>(stats.touchdowns[0]), static_cast<unsigned long long>(stats.touchdowns[1]),
+      error.c_str());
+  ctx.writeSummary(std::string(buf) + "\"latency_us\": " + latency_us.json() + "}");
+  return exit_code;
+}

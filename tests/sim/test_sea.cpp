@@ -80,7 +80,9 @@ TEST(SimSea, SpeedLimitHoldsInSimulation) {
       const double w = sim.groundTruth().qd[mft::model::kActuatedIndex[static_cast<std::size_t>(i)]];
       max_rate = std::max(max_rate, std::abs(w));
       // The torque of a step is set from the rate at its start.
-      if (std::abs(w_before[i]) >= limit) EXPECT_LE(sim.sensors().sea_torque[static_cast<std::size_t>(i)] * w_before[i], 0.0);
+      if (std::abs(w_before[i]) >= limit) {
+        EXPECT_LE(sim.sensors().sea_torque[static_cast<std::size_t>(i)] * w_before[i], 0.0);
+      }
     }
   }
   std::cout << "max hip rate with 50 N m: " << max_rate << " rad/s (limit " << limit << ")\n";

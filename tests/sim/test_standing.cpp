@@ -42,7 +42,7 @@ TEST_P(SimStanding, HoldsWithClosedLoopsAndWeightOnFeet) {
   }
   const auto& gt = sim.groundTruth();
   std::cout << "substeps " << o.substeps << ": z " << gt.q[1] << " pitch " << gt.q[2] << " max closure error "
-            << sim.stats().max_closure_error_m << " m, sum Fz / mg = " << fz_sum / n / weight
+            << sim.stats().max_closure_error_m << " m, sum Fz / mg - 1 = " << fz_sum / n / weight - 1.0
             << ", IMU a_z " << az_sum / n << "\n";
   EXPECT_LT(sim.stats().max_closure_error_m, 1e-6);
   EXPECT_NEAR(fz_sum / n, weight, 0.005 * weight);

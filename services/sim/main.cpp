@@ -97,13 +97,17 @@ int main(int argc, char** argv) {
   sim::StandingPose pose;
   pose.base_height_m = scenario.initial_base_height_m;
   simulator.reset(pose);
+  // Pushes at a time go to the simulator now; a push at a lift-off is armed only from its time on (the
+  // simulator triggers at the next lift-off after it is scheduled).
+  std::vector<std::pair<double, sim::ImpulseSpec>> armed_pushes;
   for (const auto& p : scenario.pushes) {
     sim::ImpulseSpec spec;
     spec.impulse_Ns = {p.impulse_Ns, 0.0};
     spec.time_s = p.at_s;
     spec.trigger = p.at_liftoff_leg < 0 ? sim::ImpulseTrigger::AtTime : sim::ImpulseTrigger::AtLiftOff;
     spec.leg = std::max(0, p.at_liftoff_leg);
-    simulator.scheduleImpulse(spec);
+    if (spec.trigger == sim::ImpulseTrigger::AtTime) simulator.scheduleImpulse(spec);
+    else armed_pushes.emplace_back(p.at_s, spec);
   }
 
   const double command_timeout_s = cli.getDouble("command-timeout", 0.01, 3600);
@@ -226,6 +230,14 @@ int main(int argc, char** argv) {
       std::lock_guard<std::mutex> lock(mutex);
       for (const auto& p : pending_pushes) simulator.scheduleImpulse(p);
       pending_pushes.clear();
+    }
+    for (auto it = armed_pushes.begin(); it != armed_pushes.end();) {
+      if (it->first <= simulator.time() + 1e-9) {
+        simulator.scheduleImpulse(it->second);
+        it = armed_pushes.erase(it);
+      } else {
+        ++it;
+      }
     }
     simulator.setCommand(command);
     simulator.step();

@@ -1,5 +1,7 @@
 #include "services/runtime/convert.hpp"
 
+#include "wbc/reference_from_plan.hpp"
+
 namespace mft::services {
 
 namespace {
@@ -88,17 +90,20 @@ void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out) {
 }
 
 void toMsg(const planner::PlanOutput& in, msg::Reference* out) {
+  // The controller's part goes through the shared mapping (wbc/reference_from_plan.hpp), the one the
+  // in-process closed loop uses too; the rest is schedule information for recording.
+  const wbc::WbcReference r = wbc::referenceFromPlan(in);
   out->tick(in.tick);
   out->stamp_ns(toStampNs(in.time_s));
   out->step_index(in.step_index);
   out->phase(in.phase);
   out->stance_leg(static_cast<std::int16_t>(in.stance_leg));
-  out->foot_in_stance({in.foot[0].stance, in.foot[1].stance});
-  copyOut(in.base_z, &out->base_z());
-  copyOut(in.base_pitch, &out->base_pitch());
-  copyOut(in.footPos(), &out->foot_pos());
-  copyOut(in.footVel(), &out->foot_vel());
-  copyOut(in.footAcc(), &out->foot_acc());
+  out->foot_in_stance(r.foot_in_stance);
+  out->base_z({r.base_z.pos, r.base_z.vel, r.base_z.acc});
+  out->base_pitch({r.base_pitch.pos, r.base_pitch.vel, r.base_pitch.acc});
+  copyOut(r.foot_pos, &out->foot_pos());
+  copyOut(r.foot_vel, &out->foot_vel());
+  copyOut(r.foot_acc, &out->foot_acc());
 }
 
 void fromMsg(const msg::Reference& in, wbc::WbcReference* out) {

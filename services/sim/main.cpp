@@ -112,7 +112,11 @@ int main(int argc, char** argv) {
 
   const double command_timeout_s = cli.getDouble("command-timeout", 0.01, 3600);
   const double start_timeout_s = cli.getDouble("start-timeout", 0.1, 3600);
-  services::CommandWatchdog watchdog(static_cast<std::int64_t>(cli.getDouble("watchdog-ms", 1, 10000) * 1e6));
+  const auto watchdog_timeout_ns = static_cast<std::int64_t>(cli.getDouble("watchdog-ms", 1, 10000) * 1e6);
+  services::CommandWatchdog watchdog(watchdog_timeout_ns);
+  services::LatencyStats detection_ms(10000);
+  bool damping_now = false;
+  std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
   const bool quiet = cli.isSet("quiet");
 
   // Commands arrive on a DDS thread; the loop below owns the simulator.
@@ -182,7 +186,7 @@ int main(int argc, char** argv) {
   services::RunMonitor monitor(criteria, 1.0);
   const bool forever = cli.isSet("forever");
   const auto ticks_total = static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s));
-  std::uint64_t damping_ticks = 0, last_progress_tick = 0;
+  std::uint64_t damping_ticks = 0, startup_ticks = 0, last_progress_tick = 0;
   int exit_code = 0;
   std::string error;
   const auto wall_start = Clock::now();
@@ -221,7 +225,23 @@ int main(int argc, char** argv) {
       std::this_thread::sleep_until(next_wakeup);
       std::lock_guard<std::mutex> lock(mutex);
       command = latest;  // zero-order hold of the newest command
-      if (!have_command || watchdog.damping(nowNs())) {
+      const bool was_damping = damping_now;
+      damping_now = have_command && watchdog.damping(nowNs());
+      if (damping_now && !was_damping) {
+        // How long after the deadline (last command + timeout) the actuators went into damping.
+        const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.lastArrivalNs() - watchdog_timeout_ns) * 1e-6;
+        detection_ms.add(late_ms);
+        if (episodes.size() < 64) episodes.push_back({simulator.time(), late_ms, -1.0});
+        std::printf("mft-sim: no command for %.1f ms: actuators damping (t = %.3f s)\n",
+                    static_cast<double>(watchdog_timeout_ns) * 1e-6 + late_ms, simulator.time());
+        std::fflush(stdout);
+      }
+      if (was_damping && !damping_now && !episodes.empty() && episodes.back()[2] < 0)
+        episodes.back()[2] = (simulator.time() - episodes.back()[0]) * 1e3;
+      if (!have_command) {
+        command.mode = model::CommandMode::Damping;  // start-up: the first command is still on its way
+        ++startup_ticks;
+      } else if (damping_now) {
         command.mode = model::CommandMode::Damping;
         ++damping_ticks;
       }
@@ -266,7 +286,7 @@ int main(int argc, char** argv) {
       "{\"service\": \"mft-sim\", \"scenario\": \"%s\", \"mode\": \"%s\", \"fell\": %s, \"fall_time_s\": %.4f, "
       "\"fall_reason\": \"%s\", \"ticks\": %llu, \"sim_time_s\": %.4f, \"wall_time_s\": %.3f, "
       "\"real_time_factor\": %.3f, \"deadline_misses\": %llu, \"lost_commands\": %llu, \"damping_ticks\": %llu, "
-      "\"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
+      "\"startup_ticks\": %llu, \"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
       "\"base_height_error_m\": {\"rms\": %.6f, \"max\": %.6f}, \"pitch_error_rad\": {\"rms\": %.6f, \"max\": %.6f}, "
       "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
       "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", ",
@@ -274,12 +294,22 @@ int main(int argc, char** argv) {
       monitor.fallTime(), monitor.fallReason().c_str(), static_cast<unsigned long long>(simulator.tick()),
       simulator.time(), wall_s, simulator.time() / std::max(wall_s, 1e-9),
       static_cast<unsigned long long>(watchdog.deadlineMisses()), static_cast<unsigned long long>(watchdog.lostCommands()),
-      static_cast<unsigned long long>(damping_ticks), static_cast<unsigned long long>(watchdog.recoveries()),
+      static_cast<unsigned long long>(damping_ticks), static_cast<unsigned long long>(startup_ticks),
+      static_cast<unsigned long long>(watchdog.recoveries()),
       static_cast<unsigned long long>(command_reader.requestedDeadlineMisses()), monitor.heightError().rms(),
       monitor.heightError().max_abs, monitor.pitchError().rms(), monitor.pitchError().max_abs, monitor.averageSpeed(),
       monitor.distance(), simulator.groundTruth().q[1], stats.impulses.size(), stats.max_closure_error_m,
       static_cast<unsigned long long>(stats.touchdowns[0]), static_cast<unsigned long long>(stats.touchdowns[1]),
       error.c_str());
-  ctx.writeSummary(std::string(buf) + "\"latency_us\": " + latency_us.json() + "}");
+  std::string episode_json = "[";
+  for (std::size_t i = 0; i < episodes.size(); ++i) {
+    char e[96];
+    std::snprintf(e, sizeof e, "%s[%.4f, %.3f, %.1f]", i ? ", " : "", episodes[i][0], episodes[i][1],
+                  episodes[i][2] < 0 ? (simulator.time() - episodes[i][0]) * 1e3 : episodes[i][2]);
+    episode_json += e;
+  }
+  episode_json += "]";
+  ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"latency_us\": " + latency_us.json() +
+                   ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() + "}");
   return exit_code;
 }

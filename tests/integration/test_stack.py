@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Integration tests of the multi-process stack: real mft-sim, mft-estimator, mft-planner and mft-wbc processes
+started through services/mft-supervisor, each test on its own DDS domain, bounded in time, every process
+cleaned up even on failure. Needs MFT_BIN_DIR (set by CTest) pointing at the built executables."""
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+CONFIG = REPO / "config"
+SCENARIOS = CONFIG / "scenarios"
+# A domain block of its own per test process so that parallel CTest runs never meet.
+DOMAIN_BASE = 100 + (os.getpid() % 40) * 3
+
+
+def pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except (ProcessLookupError, OSError):
+        return False
+
+
+class StackTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = Path(tempfile.mkdtemp(prefix="mft-stack-test-"))
+        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
+        self.procs = []
+        self.domain_used = []
+
+    def tearDown(self):
+        for d in self.domain_used:  # a background stack left by a failed test
+            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
+                           capture_output=True, timeout=60)
+        for p in self.procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def supervisor(self, *args, timeout=240):
+        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
+        if args[0] in ("run", "up"):
+            cmd += ["--bin-dir", str(BIN)]
+        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        out, err = p.communicate(timeout=timeout)
+        return p.returncode, out, err
+
+    def run_json(self, scenario, domain, *extra):
+        code, out, err = self.supervisor("run", SCENARIOS / scenario, "--domain", domain, "--json",
+                                         "--run-dir", self.tmp / f"run-{domain}", *extra)
+        try:
+            summary = json.loads(out)
+        except ValueError:
+            self.fail(f"no JSON summary (exit {code}): {err[-3000:]}")
+        return code, summary, err
+
+    def test_lockstep_steps_in_place_with_ticks_matching_on_every_topic(self):
+        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE)
+        self.assertEqual(code, 0, err[-3000:])
+        self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))
+        self.assertEqual(s["ticks"], 10000)
+        self.assertAlmostEqual(s["sim_time_s"], 10.0, places=6)
+        for name in ("mft-estimator", "mft-planner", "mft-wbc"):
+            svc = s["services"][name]
+            self.assertEqual(svc["ticks"], 10000, name)       # every tick answered once
+            self.assertEqual(svc["last_tick"], 9999, name)    # on the simulator's clock
+        self.assertEqual(s["services"]["mft-wbc"]["non_optimal_solves"], 0)
+        self.assertEqual(s["wbc_safety_events"], 0)
+        sim = s["services"]["mft-sim"]
+        self.assertLess(sim["max_closure_error_m"], 1e-5)
+        self.assertGreater(sim["touchdowns"][0], 5)          # it really steps
+        self.assertLess(abs(sim["average_speed_mps"]), 0.05)
+
+    def test_realtime_steps_in_place(self):
+        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime")
+        self.assertEqual(code, 0, err[-3000:])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], 10000)
+        self.assertGreater(s["wall_time_s"], 9.9)             # it ran on the wall clock
+        self.assertGreater(sim["latency_us"]["count"], 9000)  # nearly every command answered within its period
+        print(f"\nrealtime: deadline misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, "
+              f"latency p50 {sim['latency_us']['p50']:.0f} us p99 {sim['latency_us']['p99']:.0f} us", file=sys.stderr)
+
+    def test_killed_controller_puts_the_sim_into_damping_and_is_restarted(self):
+        domain = DOMAIN_BASE + 2
+        self.domain_used.append(domain)
+        code, out, err = self.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode", "realtime",
+                                         timeout=120)
+        self.assertEqual(code, 0, err)
+        time.sleep(2.0)
+        st = json.loads(subprocess.run([sys.executable, str(SUPERVISOR), "status", "--domain", str(domain), "--json"],
+                                       env=self.env, capture_output=True, text=True, timeout=30).stdout)
+        wbc_pid = st["services"]["mft-wbc"]["pid"]
+        run_dir = Path(st["run_dir"])
+        os.kill(wbc_pid, signal.SIGKILL)
+        deadline = time.time() + 20
+        restarted = False
+        while time.time() < deadline and not restarted:
+            time.sleep(0.2)
+            log = (run_dir / "mft-wbc.log").read_text(errors="replace")
+            restarted = log.count("READY mft-wbc") >= 2
+        self.assertTrue(restarted, "the supervisor did not restart mft-wbc")
+        time.sleep(1.5)  # commands flow again
+        code, out, err = self.supervisor("down", "--domain", domain, timeout=60)
+        self.domain_used.remove(domain)
+        self.assertEqual(code, 0, err)
+        self.assertFalse(pid_alive(wbc_pid))
+        sim = json.loads((run_dir / "mft-sim.summary.json").read_text())
+        self.assertGreaterEqual(sim["deadline_misses"], 1)
+        self.assertGreaterEqual(sim["watchdog_recoveries"], 1)   # back to normal commands after the restart
+        self.assertGreater(sim["damping_ticks"], 0)
+        # The kill is the longest damping episode (the others are single late commands): the sim must have
+        # gone into damping within 5 ms after the deadline, and stayed there until the restarted WBC answered.
+        onset, late_ms, duration_ms = max(sim["damping_episodes"], key=lambda e: e[2])
+        self.assertGreater(duration_ms, 50.0, sim["damping_episodes"])
+        self.assertLessEqual(late_ms, 5.0, sim["damping_episodes"])
+        print(f"\nkill -9 mft-wbc: damping {late_ms:.2f} ms after the deadline, for {duration_ms:.0f} ms until the "
+              f"restarted controller answered; all episodes {sim['damping_episodes']}", file=sys.stderr)
+
+    def test_bad_inputs_give_clear_errors_and_start_nothing(self):
+        bad = self.tmp / "bad"
+        bad.mkdir()
+        (bad / "malformed.yaml").write_text("name: [unclosed\n")
+        text = (SCENARIOS / "stand.yaml").read_text()
+        (bad / "unknown-key.yaml").write_text(text.replace("duration_s: 10.0", "duration_s: 10.0\nspeed_up: 2"))
+        (bad / "bad-controller.yaml").write_text(text.replace("controller: mft", "controller: pid"))
+        cases = [
+            (bad / "malformed.yaml", [], "not valid YAML"),
+            (bad / "unknown-key.yaml", [], "unknown key speed_up"),
+            (bad / "bad-controller.yaml", [], "controller: unknown value 'pid'"),
+            (SCENARIOS / "stand.yaml", ["--domain", "999"], "bad domain id 999"),
+        ]
+        for scenario, extra, expect in cases:
+            args = ["run", scenario] + (extra or ["--domain", DOMAIN_BASE])
+            code, out, err = self.supervisor(*args, timeout=60)
+            self.assertEqual(code, 2, (scenario, err))
+            self.assertIn(expect, err)
+        cfg = self.tmp / "config"
+        shutil.copytree(CONFIG, cfg)
+        (cfg / "wbc.yaml").unlink()
+        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN_BASE, "--config-dir", cfg)
+        self.assertEqual(code, 2)
+        self.assertIn("missing configuration", err)
+        self.assertFalse((self.tmp / "runs").exists(), "a run folder was created: something started")
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

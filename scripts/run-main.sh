@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Quick-start command 1: install what is missing, build (Release) and run the main job.
-# The main job today is the offline MFT preferable-space tool (mft-space) on the default robot;
-# it becomes the multi-process demo stack once the services land.
+# Quick-start command 1: install what is missing, build (Release) and run the main job: the whole
+# multi-process stack (mft-sim, mft-estimator, mft-planner, mft-wbc on DDS, lockstep) playing the `demo`
+# scenario through the supervisor, with a printed summary. Logs and summaries go to runs/.
+# Extra arguments go to the supervisor, e.g. --mode realtime, --json, --domain 5.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh release
-mkdir -p out
-exec build/release/bin/mft-space all --out out/mft-space "$@"
+exec python3 services/mft-supervisor run config/scenarios/demo.yaml --bin-dir build/release/bin "$@"

@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
   services::ServiceContext::declareOptions(cli);
   cli.option("dump-qp", "write the QP of the ticks in --dump-ticks to this folder (WBCQP v1 format)");
   cli.option("dump-ticks", "comma-separated tick numbers for --dump-qp", "0");
+  cli.option("reference-max-age", "realtime: answer tick k with a Reference of tick k-N..k (takes the planner "
+             "off the critical path; lockstep always needs Reference(k))", "2");
   cli.parse(argc, argv);
   services::installShutdownHandlers();
   services::ServiceContext ctx("mft-wbc", cli);
@@ -100,10 +102,12 @@ int main(int argc, char** argv) {
   services::TopicWriter<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> diag_writer(
       ctx.participant(), "WbcDiagnostics", ctx.lockstep() ? "reliable_writer" : "control_writer");
 
+  const std::uint64_t max_age = ctx.lockstep() ? 0 : static_cast<std::uint64_t>(cli.getInt("reference-max-age", 0, 50));
   auto process = [&] {
-    if (!have_state || !have_reference || state.tick != reference.tick) return;
+    if (!have_state || !have_reference) return;
+    if (reference.tick > state.tick || state.tick - reference.tick > max_age) return;
     if (answered && state.tick == last_tick) {
-      command_writer.write(command_msg);  // a repeated tick gets the same answer
+      if (ctx.lockstep()) command_writer.write(command_msg);  // a repeated tick gets the same answer
       return;
     }
     if (answered && state.tick < last_tick) return;

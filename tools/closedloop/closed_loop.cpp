@@ -1,0 +1,295 @@
+#include "tools/closedloop/closed_loop.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "wbc/reference_from_plan.hpp"
+
+namespace mft::closedloop {
+namespace {
+
+double wallNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+planner::LocomotionMode toPlannerMode(services::LocomotionMode m) {
+  switch (m) {
+    case services::LocomotionMode::Stand: return planner::LocomotionMode::Stand;
+    case services::LocomotionMode::StepInPlace: return planner::LocomotionMode::StepInPlace;
+    case services::LocomotionMode::Walk: return planner::LocomotionMode::Walk;
+  }
+  return planner::LocomotionMode::Stand;
+}
+
+wbc::WbcConfig withVariant(wbc::WbcConfig c, const std::string& controller) {
+  if (!wbc::parseVariant(controller, &c.variant))
+    throw std::invalid_argument("closed loop: unknown controller '" + controller + "'");
+  return c;
+}
+
+estimator::EstimatorConfig withMode(estimator::EstimatorConfig c, const std::string& mode) {
+  c.mode = mode == "ground_truth" ? estimator::EstimatorMode::GroundTruth : estimator::EstimatorMode::Kalman;
+  return c;
+}
+
+services::FallCriteria criteriaOf(const services::Scenario& s) {
+  services::FallCriteria c;
+  c.base_height_below_m = s.fall_base_height_m;
+  c.pitch_beyond_rad = s.fall_pitch_rad;
+  return c;
+}
+
+}  // namespace
+
+Configs loadConfigs(const std::string& dir) {
+  Configs c;
+  c.config_dir = dir;
+  c.robot = model::loadRobotDescription(dir + "/robot.yaml");
+  c.sim = sim::loadSimOptions(dir + "/sim.yaml");
+  c.estimator = estimator::loadEstimatorConfig(dir + "/estimator.yaml");
+  c.planner = planner::loadPlannerConfig(dir + "/planner.yaml");
+  c.wbc = wbc::loadWbcConfig(dir + "/wbc.yaml");
+  c.polytope = model::loadMftPolytope(dir + "/mft_space.yaml", c.robot);
+  return c;
+}
+
+services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
+                                const std::string& estimator, double step_at_s, bool stand_only) {
+  services::Scenario s;
+  s.name = stand_only ? "stand" : (speed_mps != 0.0 ? "walk" : "step-in-place");
+  s.description = "built by mft-closedloop";
+  s.duration_s = duration_s;
+  s.controller = controller;
+  s.estimator = estimator;
+  s.terrain = "flat";
+  s.initial_base_height_m = height_m;
+  s.fall_base_height_m = 0.25;  // the scenario files' values
+  s.fall_pitch_rad = 0.8;
+  s.commands.push_back({0.0, services::LocomotionMode::Stand, height_m, 0.0});
+  if (!stand_only)
+    s.commands.push_back({step_at_s,
+                          speed_mps != 0.0 ? services::LocomotionMode::Walk : services::LocomotionMode::StepInPlace,
+                          height_m, speed_mps});
+  return s;
+}
+
+ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenario, const RunOptions& options)
+    : configs_(configs),
+      scenario_(scenario),
+      options_(options),
+      terrain_(sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml")),
+      state_builder_(configs.robot),
+      monitor_(criteriaOf(scenario), options.stats_from_s) {
+  sim_ = std::make_unique<sim::Simulator>(configs_.robot, configs_.sim, terrain_);
+  sim::StandingPose pose;
+  pose.base_height_m = scenario_.initial_base_height_m;
+  sim_->reset(pose);
+  estimator_ = std::make_unique<estimator::StateEstimator>(withMode(configs_.estimator, scenario_.estimator),
+                                                           configs_.robot);
+  planner_ = std::make_unique<planner::MotionPlanner>(configs_.planner, configs_.robot);
+  wbc_ = std::make_unique<wbc::WholeBodyController>(configs_.robot, withVariant(configs_.wbc, scenario_.controller),
+                                                    &configs_.polytope);
+  // Pushes as mft-sim plays them: at a time straight away; at a lift-off armed only from their time on.
+  for (const auto& p : scenario_.pushes) {
+    sim::ImpulseSpec spec;
+    spec.impulse_Ns = {p.impulse_Ns, 0.0};
+    spec.time_s = p.at_s;
+    spec.trigger = p.at_liftoff_leg < 0 ? sim::ImpulseTrigger::AtTime : sim::ImpulseTrigger::AtLiftOff;
+    spec.leg = std::max(0, p.at_liftoff_leg);
+    if (spec.trigger == sim::ImpulseTrigger::AtTime) sim_->scheduleImpulse(spec);
+    else armed_pushes_.emplace_back(p.at_s, spec);
+  }
+  ticks_total_ = static_cast<std::uint64_t>(std::llround(scenario_.duration_s / configs_.sim.control_period_s));
+  z_cmd_ = scenario_.commands.front().z_cmd_m;
+  summary_.min_base_z = 1e9;
+  summary_.max_base_z = -1e9;
+  summary_.max_mft_violation = -1e9;
+  wall_start_ = wallNow();
+}
+
+ClosedLoop::~ClosedLoop() = default;
+
+bool ClosedLoop::step() {
+  if (finished_) return false;
+  if (sim_->tick() >= ticks_total_) {
+    finished_ = true;
+    return false;
+  }
+  const model::SensorReadings& sensors = sim_->sensors();
+  const model::GroundTruthState& truth = sim_->groundTruth();
+  truth_at_estimate_ = truth;
+
+  // Estimator: started from the simulator's initial pose, as mft-estimator does.
+  if (!estimator_initialized_) {
+    estimator_->initialize(truth.q.head<3>(), truth.qd.head<3>(), sensors);
+    estimator_initialized_ = true;
+  }
+  estimate_ = estimator_->update(sensors, &truth);
+
+  // Planner, with the scenario's commands due by now (mft-planner's rule).
+  while (next_command_ < scenario_.commands.size() &&
+         scenario_.commands[next_command_].at_s <= estimate_.time_s + 1e-9) {
+    const auto& c = scenario_.commands[next_command_++];
+    const auto result = planner_->setCommand({c.z_cmd_m, c.v_cmd_mps, toPlannerMode(c.mode)});
+    if (!result.accepted) std::fprintf(stderr, "closed loop: command rejected: %s\n", result.reason.c_str());
+  }
+  const planner::PlanOutput& plan = planner_->update(state_builder_.build(estimate_));
+  reference_ = wbc::referenceFromPlan(plan);
+  reference_.tick = estimate_.tick;
+
+  command_ = wbc_->update(estimate_, reference_, &diag_);
+  command_.tick = estimate_.tick;
+
+  for (auto it = armed_pushes_.begin(); it != armed_pushes_.end();) {
+    if (it->first <= sim_->time() + 1e-9) {
+      sim_->scheduleImpulse(it->second);
+      it = armed_pushes_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  sim_->setCommand(command_);
+  sim_->step();
+
+  // mft-sim's height command for the statistics: the one in force at the new time.
+  for (const auto& c : scenario_.commands)
+    if (c.at_s <= sim_->time()) z_cmd_ = c.z_cmd_m;
+  const bool fell_now = monitor_.update(sim_->groundTruth(), z_cmd_, sim_->stats().body_contact_steps);
+  accumulate();
+  if (fell_now && options_.stop_at_fall) finished_ = true;
+  if (sim_->tick() >= ticks_total_) finished_ = true;
+  return !finished_;
+}
+
+void ClosedLoop::accumulate() {
+  RunSummary& s = summary_;
+  const auto& truth = sim_->groundTruth();
+  s.ticks = sim_->tick();
+  s.sim_time_s = sim_->time();
+  s.wall_time_s = wallNow() - wall_start_;
+  s.fell = monitor_.fell();
+  s.fall_time_s = monitor_.fallTime();
+  s.fall_reason = monitor_.fallReason();
+  s.body_contact_steps = sim_->stats().body_contact_steps;
+  if (diag_.qp_attempted && diag_.status != qp::QpStatus::Optimal) ++s.non_optimal_solves;
+  if (diag_.safety_event != wbc::SafetyEvent::None) ++s.safety_events;
+  if (diag_.torque_clamped) ++s.torque_clamped_ticks;
+  const auto& plan = planner_->output();
+  if (plan.step_index != last_step_seen_) {
+    if (last_step_seen_ > 0) {
+      switch (plan.last_touchdown) {
+        case planner::TouchdownKind::Forced: ++s.forced_touchdowns; break;
+        case planner::TouchdownKind::Late: ++s.late_touchdowns; break;
+        case planner::TouchdownKind::Early: ++s.early_touchdowns; break;
+        default: break;
+      }
+    }
+    last_step_seen_ = plan.step_index;
+  }
+  s.steps = plan.step_index;
+
+  // The window: statistics of the truth after the tick, and of the estimate the controller used against the
+  // truth it was computed from.
+  const double t = sim_->time();
+  if (t < options_.stats_from_s - 1e-9 || monitor_.fell()) return;
+  if (n_window_ == 0) {
+    window_x0_ = truth.q[model::kBaseX];
+    window_t0_ = t;
+  }
+  ++n_window_;
+  const double z = truth.q[model::kBaseZ], p = truth.q[model::kBasePitch];
+  sum_z_ += z;
+  sum_ez2_ += (z - z_cmd_) * (z - z_cmd_);
+  sum_p2_ += p * p;
+  const auto& tr = truth_at_estimate_;
+  const double ez = estimate_.q[model::kBaseZ] - tr.q[model::kBaseZ];
+  const double ep = estimate_.q[model::kBasePitch] - tr.q[model::kBasePitch];
+  const double ev = estimate_.qd[model::kBaseX] - tr.qd[model::kBaseX];
+  sum_est_z2_ += ez * ez;
+  sum_est_p2_ += ep * ep;
+  sum_est_vx2_ += ev * ev;
+  const double n = static_cast<double>(n_window_);
+  s.window_s = t - window_t0_;
+  s.mean_base_z = sum_z_ / n;
+  s.rms_base_z_error = std::sqrt(sum_ez2_ / n);
+  s.max_abs_base_z_error = std::max(s.max_abs_base_z_error, std::abs(z - z_cmd_));
+  s.rms_pitch = std::sqrt(sum_p2_ / n);
+  s.max_abs_pitch = std::max(s.max_abs_pitch, std::abs(p));
+  s.min_base_z = std::min(s.min_base_z, z);
+  s.max_base_z = std::max(s.max_base_z, z);
+  s.average_speed = s.window_s > 0 ? (truth.q[model::kBaseX] - window_x0_) / s.window_s : 0.0;
+  s.est_rms_z = std::sqrt(sum_est_z2_ / n);
+  s.est_rms_pitch = std::sqrt(sum_est_p2_ / n);
+  s.est_rms_vx = std::sqrt(sum_est_vx2_ / n);
+  model::VectorA qa;
+  for (int i = 0; i < model::kNa; ++i) qa[i] = truth.q[model::kActuatedIndex[i]];
+  s.max_mft_violation = std::max(s.max_mft_violation, (configs_.polytope.A * qa - configs_.polytope.b).maxCoeff());
+  s.min_lti = std::min({s.min_lti, truth.lti[0], truth.lti[1]});
+}
+
+const RunSummary& ClosedLoop::run(const std::function<void(const ClosedLoop&)>& each_tick) {
+  while (step())
+    if (each_tick) each_tick(*this);
+  if (each_tick && sim_->tick() > 0 && finished_) each_tick(*this);
+  return summary_;
+}
+
+std::string RunSummary::toJson() const {
+  std::ostringstream o;
+  o.precision(6);
+  o << "{\"fell\": " << (fell ? "true" : "false") << ", \"fall_time_s\": " << fall_time_s << ", \"fall_reason\": \""
+    << fall_reason << "\", \"ticks\": " << ticks << ", \"sim_time_s\": " << sim_time_s
+    << ", \"wall_time_s\": " << wall_time_s << ", \"window_s\": " << window_s << ", \"mean_base_z_m\": " << mean_base_z
+    << ", \"min_base_z_m\": " << min_base_z << ", \"max_base_z_m\": " << max_base_z
+    << ", \"rms_base_z_error_m\": " << rms_base_z_error << ", \"max_abs_base_z_error_m\": " << max_abs_base_z_error
+    << ", \"rms_pitch_rad\": " << rms_pitch << ", \"max_abs_pitch_rad\": " << max_abs_pitch
+    << ", \"average_speed_mps\": " << average_speed << ", \"estimator_rms_error\": {\"z_m\": " << est_rms_z
+    << ", \"pitch_rad\": " << est_rms_pitch << ", \"vx_mps\": " << est_rms_vx << "}"
+    << ", \"max_mft_violation\": " << max_mft_violation << ", \"min_lti\": " << min_lti << ", \"steps\": " << steps
+    << ", \"touchdowns\": {\"early\": " << early_touchdowns << ", \"late\": " << late_touchdowns
+    << ", \"forced\": " << forced_touchdowns << "}, \"non_optimal_solves\": " << non_optimal_solves
+    << ", \"safety_events\": " << safety_events << ", \"torque_clamped_ticks\": " << torque_clamped_ticks
+    << ", \"body_contact_steps\": " << body_contact_steps << "}";
+  return o.str();
+}
+
+std::string ClosedLoop::csvHeader() {
+  return "t,x,z,pitch,vx,vz,pitch_rate,q4,q5,q6,q7,q8,q9,q10,q11,est_x,est_z,est_pitch,est_vx,est_vz,"
+         "z_ref,pitch_ref,z_cmd,stance_leg,phase,step,swing_extended,ref_stance_r,ref_stance_l,"
+         "foot_ref_rx,foot_ref_rz,foot_ref_lx,foot_ref_lz,foot_rx,foot_rz,foot_lx,foot_lz,"
+         "contact_r,contact_l,est_contact_r,est_contact_l,fz_r,fz_l,fx_r,fx_l,qp_fz_r,qp_fz_l,"
+         "tau0,tau1,tau2,tau3,qp_status,slack,mft_violation,lti_r,lti_l,target_x";
+}
+
+std::string ClosedLoop::csvRow() const {
+  const auto& tr = truth_at_estimate_;
+  const auto& e = estimate_;
+  const auto& p = planner_->output();
+  std::ostringstream o;
+  o.precision(7);
+  o << tr.time_s;
+  for (int i = 0; i < 6; ++i) o << ',' << (i < 3 ? tr.q[i] : tr.qd[i - 3]);
+  for (int i = 3; i < model::kNq; ++i) o << ',' << tr.q[i];
+  o << ',' << e.q[0] << ',' << e.q[1] << ',' << e.q[2] << ',' << e.qd[0] << ',' << e.qd[1];
+  o << ',' << reference_.base_z.pos << ',' << reference_.base_pitch.pos << ',' << z_cmd_;
+  o << ',' << p.stance_leg << ',' << p.phase << ',' << p.step_index << ',' << (p.swing_extended ? 1 : 0);
+  o << ',' << reference_.foot_in_stance[0] << ',' << reference_.foot_in_stance[1];
+  for (int i = 0; i < model::kNc; ++i) o << ',' << reference_.foot_pos[i];
+  const auto& md = wbc_->modelData();  // the controller's model at the estimate
+  for (int i = 0; i < model::kNc; ++i) o << ',' << md.foot_pos[i];
+  o << ',' << (tr.contact_force[1] > configs_.sim.contact_switch_threshold_N) << ','
+    << (tr.contact_force[3] > configs_.sim.contact_switch_threshold_N);
+  o << ',' << e.contact[0] << ',' << e.contact[1];
+  o << ',' << tr.contact_force[1] << ',' << tr.contact_force[3] << ',' << tr.contact_force[0] << ','
+    << tr.contact_force[2];
+  o << ',' << diag_.f_c[1] << ',' << diag_.f_c[3];
+  for (int i = 0; i < model::kNa; ++i) o << ',' << command_.tau[i];
+  o << ',' << static_cast<int>(diag_.status) << ',' << diag_.slack_norm << ',' << diag_.mft_violation;
+  o << ',' << tr.lti[0] << ',' << tr.lti[1] << ',' << p.target_x;
+  return o.str();
+}
+
+}  // namespace mft::closedloop

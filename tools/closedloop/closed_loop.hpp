@@ -1,0 +1,141 @@
+#pragma once
+// In-process closed loop (issue 6): simulator -> estimator -> planner -> WBC -> simulator, all on the sim clock
+// in one thread, with the configs, the PlanOutput -> WbcReference mapping (wbc/reference_from_plan.hpp), the
+// scenario loader and the fall criteria (services/runtime) that the DDS stack uses. A tuning and test bench:
+// deterministic, about 10-30x faster than real time, no processes. Not the product path (that is services/).
+//
+// Tick k, as in the lockstep stack: sensors(k) [+ truth(k)] -> estimate(k) -> scenario commands due at t_k ->
+// plan(k) -> reference(k) -> command(k) -> pushes armed by t_k -> sim.step() -> fall check on truth(k + 1).
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "estimator/state_estimator.hpp"
+#include "model/mft_polytope.hpp"
+#include "model/robot_description.hpp"
+#include "planner/motion_planner.hpp"
+#include "services/runtime/run_monitor.hpp"
+#include "services/runtime/scenario.hpp"
+#include "sim/sim_options.hpp"
+#include "sim/simulator.hpp"
+#include "sim/terrain.hpp"
+#include "wbc/wbc_config.hpp"
+#include "wbc/whole_body_controller.hpp"
+
+namespace mft::closedloop {
+
+// Every configuration a run needs, loaded from one config folder (the same files the services read).
+struct Configs {
+  std::string config_dir;
+  model::RobotDescription robot;
+  sim::SimOptions sim;
+  estimator::EstimatorConfig estimator;
+  planner::PlannerConfig planner;
+  wbc::WbcConfig wbc;
+  model::MftPolytope polytope;
+};
+// Throws config::ConfigError (naming file and key) like the services do at start-up.
+Configs loadConfigs(const std::string& config_dir);
+
+// A scenario built from a few numbers (no file): stand at `height_m` until `step_at_s`, then step in place
+// (speed 0) or walk (speed != 0) for the rest of `duration_s`.
+services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
+                                const std::string& estimator, double step_at_s = 1.0, bool stand_only = false);
+
+struct RunOptions {
+  bool stop_at_fall = true;
+  // Statistics (the summary below) are taken over [stats_from_s, end]; the RunMonitor's settle time too.
+  double stats_from_s = 2.0;
+};
+
+// Running figures over the statistics window (ground truth unless named estimator).
+struct RunSummary {
+  bool fell = false;
+  double fall_time_s = 0.0;
+  std::string fall_reason;
+  std::uint64_t ticks = 0;
+  double sim_time_s = 0.0, wall_time_s = 0.0;
+  double window_s = 0.0;               // length of the statistics window covered so far
+  double mean_base_z = 0.0;            // [m]
+  double rms_base_z_error = 0.0;       // vs the commanded height [m]
+  double max_abs_base_z_error = 0.0;
+  double rms_pitch = 0.0, max_abs_pitch = 0.0;  // [rad]
+  double min_base_z = 0.0, max_base_z = 0.0;
+  double average_speed = 0.0;          // (x_end - x_start) / window [m/s]
+  double est_rms_z = 0.0, est_rms_pitch = 0.0, est_rms_vx = 0.0;  // estimate - truth
+  double max_mft_violation = 0.0;      // max over the window of max(A q_a - b) (truth; NaN without polytope)
+  double min_lti = 1.0;
+  std::uint64_t steps = 0;             // planner lift-offs
+  std::uint64_t non_optimal_solves = 0, safety_events = 0, torque_clamped_ticks = 0;
+  std::uint64_t body_contact_steps = 0;
+  std::uint64_t forced_touchdowns = 0, late_touchdowns = 0, early_touchdowns = 0;
+  std::string toJson() const;
+};
+
+class ClosedLoop {
+ public:
+  ClosedLoop(const Configs& configs, const services::Scenario& scenario, const RunOptions& options = {});
+  ~ClosedLoop();
+
+  // One control tick. Returns false once the run is over (duration reached, or a fall with stop_at_fall).
+  bool step();
+  // Runs to the end; `each_tick` (may be empty) is called after every tick.
+  const RunSummary& run(const std::function<void(const ClosedLoop&)>& each_tick = {});
+  bool finished() const { return finished_; }
+
+  const RunSummary& summary() const { return summary_; }
+  const services::Scenario& scenario() const { return scenario_; }
+  const Configs& configs() const { return configs_; }
+  const sim::Simulator& simulator() const { return *sim_; }
+  const estimator::StateEstimator& estimator() const { return *estimator_; }
+  const planner::MotionPlanner& planner() const { return *planner_; }
+  const wbc::WholeBodyController& controller() const { return *wbc_; }
+  const services::RunMonitor& monitor() const { return monitor_; }
+  // This tick's data (valid after the first step()): what the controller saw and did.
+  const model::RobotStateEstimate& estimate() const { return estimate_; }
+  const model::GroundTruthState& truthAtEstimate() const { return truth_at_estimate_; }
+  const planner::PlanOutput& plan() const { return planner_->output(); }
+  const wbc::WbcReference& reference() const { return reference_; }
+  const wbc::WbcDiagnostics& diagnostics() const { return diag_; }
+  const model::ActuatorCommand& command() const { return command_; }
+  double commandedHeight() const { return z_cmd_; }
+
+  // CSV trace: header() once, then row() per tick (truth, estimate, reference, plan, WBC).
+  static std::string csvHeader();
+  std::string csvRow() const;
+
+ private:
+  void accumulate();
+
+  Configs configs_;
+  services::Scenario scenario_;
+  RunOptions options_;
+  sim::Terrain terrain_;
+  std::unique_ptr<sim::Simulator> sim_;
+  std::unique_ptr<estimator::StateEstimator> estimator_;
+  std::unique_ptr<planner::MotionPlanner> planner_;
+  planner::PlannerStateBuilder state_builder_;
+  std::unique_ptr<wbc::WholeBodyController> wbc_;
+  services::RunMonitor monitor_;
+  std::vector<std::pair<double, sim::ImpulseSpec>> armed_pushes_;
+  std::size_t next_command_ = 0;
+  std::uint64_t ticks_total_ = 0;
+  bool estimator_initialized_ = false, finished_ = false;
+  double z_cmd_ = 0.0;
+  model::RobotStateEstimate estimate_;
+  model::GroundTruthState truth_at_estimate_;
+  wbc::WbcReference reference_;
+  wbc::WbcDiagnostics diag_;
+  model::ActuatorCommand command_;
+  planner::TouchdownKind last_touchdown_seen_ = planner::TouchdownKind::None;
+  std::uint64_t last_step_seen_ = 0;
+
+  // Window accumulators.
+  RunSummary summary_;
+  std::uint64_t n_window_ = 0;
+  double sum_z_ = 0.0, sum_ez2_ = 0.0, sum_p2_ = 0.0, sum_est_z2_ = 0.0, sum_est_p2_ = 0.0, sum_est_vx2_ = 0.0;
+  double window_x0_ = 0.0, window_t0_ = 0.0;
+  double wall_start_ = 0.0;
+};
+
+}  // namespace mft::closedloop

@@ -1,0 +1,127 @@
+// mft-closedloop: the whole controller chain (sim, estimator, planner, WBC) in one process on the sim clock.
+// A bench for tuning, tests and plots; the product path is the DDS stack in services/.
+//
+//   mft-closedloop --scenario config/scenarios/demo.yaml --json
+//   mft-closedloop --height 0.44 --controller sa --duration 20 --csv /tmp/step.csv
+//   mft-closedloop --speed 0.3 --duration 20 --estimator ground_truth
+#include <cstdio>
+#include <fstream>
+
+#include "model/config/strict_yaml.hpp"
+#include "services/runtime/process.hpp"
+#include "tools/closedloop/closed_loop.hpp"
+
+using namespace mft;
+
+int main(int argc, char** argv) {
+  services::CommandLine cli(
+      "mft-closedloop",
+      "Run sim -> estimator -> planner -> WBC in one process on the sim clock, with the stack's configs, reference\n"
+      "mapping and fall criteria. Without --scenario: stand at --height until --step-at, then step in place\n"
+      "(--speed 0) or walk (--speed != 0). With --scenario the given options override the file's values.");
+  cli.option("scenario", "scenario file (config/scenarios/*.yaml)");
+  cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.option("controller", "mft | sa | none (default: the scenario's, else mft)");
+  cli.option("estimator", "kalman | ground_truth (default: the scenario's, else kalman)");
+  cli.option("height", "base height command and initial height [m] (default 0.42 without a scenario)");
+  cli.option("speed", "average speed command [m/s] (walk when != 0)");
+  cli.option("duration", "run length [s] (default 10 without a scenario)");
+  cli.option("step-at", "without --scenario: when stepping starts [s]", "1.0");
+  cli.flag("stand", "without --scenario: stand only, never step");
+  cli.option("push", "a sagittal push on the torso [N s] (+ forward)");
+  cli.option("push-at", "the push is armed at this time [s] and lands at the next right-foot lift-off", "5.0");
+  cli.flag("push-timed", "apply the push at --push-at itself instead of at a lift-off");
+  cli.option("stats-from", "statistics window start [s]", "2.0");
+  cli.flag("continue-after-fall", "keep running after a fall");
+  cli.option("csv", "write a per-tick trace to this CSV file");
+  cli.option("csv-every", "write every n-th tick to the CSV", "1");
+  cli.flag("json", "print the summary as JSON (default: a short text summary)");
+  cli.parse(argc, argv);
+
+  closedloop::Configs configs;
+  services::Scenario scenario;
+  try {
+    configs = closedloop::loadConfigs(cli.get("config-dir"));
+    if (cli.isSet("scenario")) {
+      scenario = services::loadScenario(cli.get("scenario"));
+    } else {
+      const double h = cli.isSet("height") ? cli.getDouble("height", 0.1, 1.0) : 0.42;
+      const double v = cli.isSet("speed") ? cli.getDouble("speed", -3.0, 3.0) : 0.0;
+      const double d = cli.isSet("duration") ? cli.getDouble("duration", 0.001, 3600.0) : 10.0;
+      scenario = closedloop::makeScenario(h, v, d, "mft", "kalman", cli.getDouble("step-at", 0.0, 3600.0),
+                                          cli.isSet("stand"));
+    }
+  } catch (const config::ConfigError& e) {
+    cli.fail(e.what());
+  }
+  // Overrides of a scenario file's values.
+  if (cli.isSet("scenario")) {
+    if (cli.isSet("height")) {
+      const double h = cli.getDouble("height", 0.1, 1.0);
+      scenario.initial_base_height_m = h;
+      for (auto& c : scenario.commands) c.z_cmd_m = h;
+    }
+    if (cli.isSet("speed")) {
+      const double v = cli.getDouble("speed", -3.0, 3.0);
+      for (auto& c : scenario.commands)
+        if (c.mode == services::LocomotionMode::Walk) c.v_cmd_mps = v;
+    }
+    if (cli.isSet("duration")) scenario.duration_s = cli.getDouble("duration", 0.001, 3600.0);
+  }
+  if (cli.isSet("controller")) scenario.controller = cli.get("controller");
+  if (cli.isSet("estimator")) scenario.estimator = cli.get("estimator");
+  if (scenario.controller != "mft" && scenario.controller != "sa" && scenario.controller != "none")
+    cli.fail("--controller: expected mft, sa or none");
+  if (scenario.estimator != "kalman" && scenario.estimator != "ground_truth")
+    cli.fail("--estimator: expected kalman or ground_truth");
+  if (cli.isSet("push")) {
+    services::ScenarioPush p;
+    p.impulse_Ns = cli.getDouble("push", -100.0, 100.0);
+    p.at_s = cli.getDouble("push-at", 0.0, 3600.0);
+    p.at_liftoff_leg = cli.isSet("push-timed") ? -1 : 0;
+    scenario.pushes.push_back(p);
+  }
+
+  closedloop::RunOptions options;
+  options.stop_at_fall = !cli.isSet("continue-after-fall");
+  options.stats_from_s = cli.getDouble("stats-from", 0.0, 3600.0);
+  std::unique_ptr<closedloop::ClosedLoop> loop;
+  try {
+    loop = std::make_unique<closedloop::ClosedLoop>(configs, scenario, options);
+  } catch (const std::exception& e) {
+    cli.fail(e.what());
+  }
+
+  std::ofstream csv;
+  const long every = cli.getInt("csv-every", 1, 1000000);
+  if (cli.isSet("csv")) {
+    csv.open(cli.get("csv"));
+    if (!csv) cli.fail("cannot write " + cli.get("csv"));
+    csv << closedloop::ClosedLoop::csvHeader() << "\n";
+  }
+  long n = 0;
+  const auto& s = loop->run([&](const closedloop::ClosedLoop& l) {
+    if (csv.is_open() && n++ % every == 0) csv << l.csvRow() << "\n";
+  });
+
+  if (cli.isSet("json")) {
+    std::printf("{\"scenario\": %s, \"summary\": %s}\n", scenario.toJson().c_str(), s.toJson().c_str());
+  } else {
+    std::printf("%s (%s, %s estimator): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
+                scenario.estimator.c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
+                s.fell ? ": " : "", s.fall_reason.c_str());
+    std::printf("  window %.1f s: base z mean %.4f m [%.4f, %.4f], rms error %.4f m; pitch rms %.4f max %.4f rad\n",
+                s.window_s, s.mean_base_z, s.min_base_z, s.max_base_z, s.rms_base_z_error, s.rms_pitch,
+                s.max_abs_pitch);
+    std::printf("  average speed %.4f m/s; steps %llu (early %llu, late %llu, forced %llu); estimator rms z %.4f m, "
+                "pitch %.4f rad, vx %.4f m/s\n",
+                s.average_speed, static_cast<unsigned long long>(s.steps),
+                static_cast<unsigned long long>(s.early_touchdowns), static_cast<unsigned long long>(s.late_touchdowns),
+                static_cast<unsigned long long>(s.forced_touchdowns), s.est_rms_z, s.est_rms_pitch, s.est_rms_vx);
+    std::printf("  max MFT violation %.4f rad, min LTI %.3f; non-optimal solves %llu, torque clamped %llu; "
+                "%.1fx real time\n",
+                s.max_mft_violation, s.min_lti, static_cast<unsigned long long>(s.non_optimal_solves),
+                static_cast<unsigned long long>(s.torque_clamped_ticks), s.sim_time_s / std::max(s.wall_time_s, 1e-9));
+  }
+  return s.fell ? 1 : 0;
+}

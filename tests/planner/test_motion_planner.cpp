@@ -97,7 +97,8 @@ TEST(MotionPlanner, SwingStartsAtLiftoffAndEndsAtTheEq13Target) {
   // The first target: eq. 13 with the LIP prediction over the full step, desired speed 0 (step in place).
   const double lambda = lipLambda(9.81, r.com_height);
   const LipState pre = lipPredict({r.x - r.feet[1].x(), r.xd}, lambda, 0.35);
-  EXPECT_NEAR(plan.target_x, r.feet[1].x() + pre.x + 0.16 * pre.xd + 0.08 * pre.xd, 1e-12);
+  const FootPlacementParams& k = config().placement;
+  EXPECT_NEAR(plan.target_x, r.feet[1].x() + pre.x + k.k_v * pre.xd + k.k_p * pre.xd, 1e-12);
   const Eigen::Vector2d support = r.feet[1];
   double final_target = 0.0;
   while (plan.stance_leg == 1) {

@@ -35,14 +35,14 @@ void expectError(const std::string& pattern, const std::string& replacement, con
 TEST(PlannerConfig, DefaultFileHasThePaperValues) {
   const auto c = loadPlannerConfig(path());
   EXPECT_DOUBLE_EQ(c.gait.step_duration_s, 0.35);
-  EXPECT_DOUBLE_EQ(c.placement.k_v, 0.16);
+  EXPECT_DOUBLE_EQ(c.placement.k_v, 0.145);  // paper 0.16: departure documented in config/planner.yaml
   EXPECT_DOUBLE_EQ(c.placement.k_p, 0.08);
   EXPECT_EQ(c.command.initial_mode, LocomotionMode::Stand);
   EXPECT_EQ(c.source_file, path());
 }
 
 TEST(PlannerConfig, MissingKeyIsNamed) { expectError(R"(\n  k_p: 0.08[^\n]*)", "", "foot_placement.k_p: missing key"); }
-TEST(PlannerConfig, UnknownKeyIsNamed) { expectError(R"(  k_v: 0.16)", "  k_v: 0.16\n  k_i: 0.01", "unknown key foot_placement.k_i"); }
+TEST(PlannerConfig, UnknownKeyIsNamed) { expectError(R"(  k_v: [0-9.]+)", "$&\n  k_i: 0.01", "unknown key foot_placement.k_i"); }
 TEST(PlannerConfig, WrongTypeIsNamed) { expectError(R"(step_duration_s: 0.35)", "step_duration_s: slow", "gait.step_duration_s: expected a number"); }
 TEST(PlannerConfig, NonPositiveDurationIsRefused) { expectError(R"(step_duration_s: 0.35)", "step_duration_s: 0", "gait.step_duration_s: must be > 0"); }
 TEST(PlannerConfig, PhaseOutOfRangeIsRefused) { expectError(R"(min_touchdown_phase: 0.6)", "min_touchdown_phase: 1.5", "gait.min_touchdown_phase: must lie in"); }

@@ -86,6 +86,7 @@ ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenari
   sim_ = std::make_unique<sim::Simulator>(configs_.robot, configs_.sim, terrain_);
   sim::StandingPose pose;
   pose.base_height_m = scenario_.initial_base_height_m;
+  pose.foot_offset_x_m = options_.foot_offset_x_m;
   sim_->reset(pose);
   estimator_ = std::make_unique<estimator::StateEstimator>(withMode(configs_.estimator, scenario_.estimator),
                                                            configs_.robot);

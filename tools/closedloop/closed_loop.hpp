@@ -46,6 +46,9 @@ struct RunOptions {
   bool stop_at_fall = true;
   // Statistics (the summary below) are taken over [stats_from_s, end]; the RunMonitor's settle time too.
   double stats_from_s = 2.0;
+  // Initial foot x offsets from the base [right, left]. mft-sim starts with both feet under the hip axis
+  // ({0, 0}): fine for stepping, but a point support for standing (SIM-ODE.md 3d stands with +-0.06 m).
+  std::array<double, model::kNumLegs> foot_offset_x_m{0.0, 0.0};
 };
 
 // Running figures over the statistics window (ground truth unless named estimator).

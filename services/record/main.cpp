@@ -1,0 +1,266 @@
+// mft-record: subscribes to every topic and writes an MRPT rawlog (services/record/rawlog_format.hpp) from a
+// writer thread; the DDS callbacks only copy into a bounded queue. Lockstep: reliable readers (every tick
+// arrives); realtime: the control profiles the writers offer. Service contract: READY once the readers
+// exist, exit 0 on SIGINT/SIGTERM after draining and closing the file, JSON summary via --summary.
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+
+#include "MftMsgsPubSubTypes.h"
+#include "model/config/strict_yaml.hpp"
+#include "services/record/recorder.hpp"
+#include "services/runtime/dds_participant.hpp"
+#include "services/runtime/scenario.hpp"
+#include "services/runtime/service_context.hpp"
+
+using namespace mft;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readFile(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+std::string utcNow() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+void writeSummary(const std::string& path, const std::string& json) {
+  if (path.empty()) return;
+  {
+    std::ofstream out(path + ".tmp");
+    out << json << "\n";
+  }
+  std::rename((path + ".tmp").c_str(), path.c_str());  // never a half-written summary
+}
+
+bool pidAlive(long pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+
+// After a crash the supervisor restarts the recorder with the same --output: continue in the next free piece
+// instead of overwriting what the crashed one wrote. A restart is recognised by the sidecar of the output:
+// still "recording", written by a recorder that is gone, under the same parent (the supervisor).
+int firstPiece(const std::string& output) {
+  const std::string sidecar = rawlog::sidecarName(output);
+  if (!fs::exists(sidecar)) return 0;
+  try {
+    const YAML::Node n = YAML::LoadFile(sidecar)["recording"];
+    if (!n || n["status"].as<std::string>("") != "recording") return 0;
+    if (n["parent_pid"].as<long>(0) != static_cast<long>(getppid()) || pidAlive(n["recorder_pid"].as<long>(0))) return 0;
+  } catch (const YAML::Exception&) {
+    return 0;
+  }
+  int piece = 1;
+  while (fs::exists(rawlog::pieceName(output, piece))) ++piece;
+  return piece;
+}
+
+namespace dds = eprosima::fastdds::dds;
+
+// The recorder's own participant: the project's "mft_participant" profile with larger socket buffers. It
+// takes in every topic of a 1 kHz stack (~10k messages/s counting the services' re-sends) on one receive
+// thread; with the kernel's default 208 KB buffer, a few ms without CPU on a loaded machine overflowed it,
+// and a lost sample of a KEEP_LAST 64 writer is gone for good (measured: ~1 % of ticks).
+class RecorderParticipant {
+ public:
+  RecorderParticipant(int domain, const std::string& profiles_file, std::uint32_t socket_buffer) {
+    auto* factory = dds::DomainParticipantFactory::get_instance();
+    if (factory->load_XML_profiles_file(profiles_file) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      throw services::DdsError("the DDS profile file " + profiles_file + " could not be loaded");
+    dds::DomainParticipantQos qos;
+    if (factory->get_participant_qos_from_profile("mft_participant", qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      throw services::DdsError(profiles_file + ": no participant profile 'mft_participant'");
+    qos.name("mft-record");
+    std::vector<std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface>> transports;
+    for (const auto& t : qos.transport().user_transports) {
+      if (auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(t)) {
+        auto copy = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(*udp);  // the profile's stays as is
+        copy->receiveBufferSize = socket_buffer;
+        transports.push_back(copy);
+      } else {
+        transports.push_back(t);
+      }
+    }
+    qos.transport().user_transports = transports;
+    qos.transport().listen_socket_buffer_size = socket_buffer;
+    participant_ = factory->create_participant(domain, qos);
+    if (!participant_) throw services::DdsError("cannot create a DDS participant on domain " + std::to_string(domain));
+    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    if (!subscriber_) throw services::DdsError("cannot create the DDS subscriber");
+  }
+  ~RecorderParticipant() {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+  dds::DomainParticipant* get() const { return participant_; }
+  dds::Subscriber* subscriber() const { return subscriber_; }
+
+ private:
+  dds::DomainParticipant* participant_ = nullptr;
+  dds::Subscriber* subscriber_ = nullptr;
+};
+
+// One topic into the recorder: the DDS receive thread copies each sample into the recorder's queue.
+template <class Msg, class PubSubType>
+class Subscription : public dds::DataReaderListener {
+ public:
+  Subscription(RecorderParticipant& p, const std::string& topic_name, const std::string& profile, rawlog::Recorder& rec)
+      : subscriber_(p.subscriber()), recorder_(rec) {
+    dds::TypeSupport type(new PubSubType());
+    type.register_type(p.get());
+    topic_ = p.get()->create_topic(topic_name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    if (!topic_) throw services::DdsError("cannot create the topic " + topic_name);
+    reader_ = subscriber_->create_datareader_with_profile(topic_, profile, this);
+    if (!reader_) throw services::DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
+  }
+  ~Subscription() override { subscriber_->delete_datareader(reader_); }
+  void on_data_available(dds::DataReader* reader) override {
+    dds::SampleInfo info;
+    while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) recorder_.push(rawlog::Message(sample_));
+  }
+
+ private:
+  dds::Subscriber* subscriber_;
+  rawlog::Recorder& recorder_;
+  dds::Topic* topic_ = nullptr;
+  dds::DataReader* reader_ = nullptr;
+  Msg sample_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  services::CommandLine cli("mft-record",
+                            "Records every topic to an MRPT rawlog (observations-only format, standard classes,\n"
+                            "metadata comment first, sidecar FILE.yaml). See docs/recording.md.");
+  services::ServiceContext::declareOptions(cli);
+  cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>)", "", true);
+  cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (RAWLOG.md)", "1");
+  cli.option("flush-ms", "flush period: a crash loses at most this much [ms]", "100");
+  cli.option("queue", "capacity of the queue between DDS and the writer [messages]", "65536");
+  cli.option("split-mb", "start a new piece past this compressed size [MB] (0 = never)", "0");
+  cli.option("split-s", "start a new piece every this many simulated seconds (0 = never)", "0");
+  cli.option("linger-ms", "on SIGTERM, keep receiving until the topics are quiet this long (at most 1 s)", "100");
+  cli.option("socket-buffer-mb", "UDP receive buffer of the recorder's participant [MB] (capped by net.core.rmem_max)", "4");
+  cli.parse(argc, argv);
+  services::installShutdownHandlers();
+  // The contract's options, read as ServiceContext does, but with the recorder's own participant (above).
+  const std::string mode = cli.get("mode");
+  if (mode != "lockstep" && mode != "realtime") cli.fail("--mode: expected lockstep or realtime, got '" + mode + "'");
+  const bool lockstep = mode == "lockstep";
+  const int domain = static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId));
+  const std::string config_dir = cli.get("config-dir");
+  auto config_file = [&](const std::string& name) { return config_dir + "/" + name; };
+  model::RobotDescription robot;
+  services::Scenario scenario;
+  try {
+    robot = model::loadRobotDescription(config_file("robot.yaml"));
+    scenario = services::loadScenario(cli.get("scenario"));
+  } catch (const config::ConfigError& e) {
+    cli.fail(e.what());
+  }
+  if (cli.isSet("rt")) services::tryRealtimeScheduling(80);
+
+  rawlog::RecorderOptions opt;
+  opt.output = fs::absolute(cli.get("output")).string();
+  opt.gzip_level = static_cast<int>(cli.getInt("gzip-level", 0, 9));
+  opt.flush_period_s = cli.getDouble("flush-ms", 1, 100) * 1e-3;
+  opt.queue_capacity = static_cast<std::size_t>(cli.getInt("queue", 64, 1 << 24));
+  opt.split_mb = cli.getDouble("split-mb", 0, 1e6);
+  opt.split_s = cli.getDouble("split-s", 0, 1e7);
+  const double linger_s = cli.getDouble("linger-ms", 0, 1000) * 1e-3;
+  opt.first_piece = firstPiece(opt.output);
+  if (opt.first_piece > 0)
+    std::printf("mft-record: restarted after a crash: continuing in %s\n", rawlog::pieceName(opt.output, opt.first_piece).c_str());
+
+  // The effective configuration of every service: the files of --config-dir they read, the scenario and
+  // its terrain, verbatim, so a recording can rebuild its controller (mft-replay --through-wbc).
+  auto& md = opt.metadata;
+  md.created_utc = utcNow();
+  md.mode = mode;
+  md.domain = domain;
+  md.scenario_file = fs::absolute(cli.get("scenario")).string();
+  md.scenario_name = scenario.name;
+  md.controller = scenario.controller;
+  md.robot_checksum = model::checksumHex(robot.checksum);
+  for (const char* f : {"robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml"}) {
+    if (!fs::exists(config_file(f))) cli.fail("missing configuration " + config_file(f));
+    md.config[f] = readFile(config_file(f));
+  }
+  md.config["scenario"] = readFile(cli.get("scenario"));
+  const std::string terrain = "terrain/" + scenario.terrain + ".yaml";
+  if (fs::exists(config_file(terrain))) md.config[terrain] = readFile(config_file(terrain));
+
+  fs::create_directories(fs::path(opt.output).parent_path());
+  rawlog::Recorder recorder(opt);
+  try {
+    recorder.start();
+  } catch (const std::exception& e) {
+    cli.fail(e.what());
+  }
+
+  std::unique_ptr<RecorderParticipant> participant;
+  try {
+    participant = std::make_unique<RecorderParticipant>(
+        domain, config_file("dds_profiles.xml"),
+        static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024));
+  } catch (const services::DdsError& e) {
+    cli.fail(e.what());
+  }
+  {
+    // The writers of the 1 kHz chain offer reliable QoS in lockstep and best effort in realtime; a reader
+    // asking for more than the writer offers would not match.
+    const std::string chain = lockstep ? "reliable_reader" : "control_reader";
+    auto& p = *participant;
+    Subscription<msg::GroundTruth, msg::GroundTruthPubSubType> r0(p, "GroundTruth", chain, recorder);
+    Subscription<msg::SensorData, msg::SensorDataPubSubType> r1(p, "SensorData", chain, recorder);
+    Subscription<msg::RobotState, msg::RobotStatePubSubType> r2(p, "RobotState", chain, recorder);
+    Subscription<msg::Reference, msg::ReferencePubSubType> r3(p, "Reference", chain, recorder);
+    Subscription<msg::JointCommand, msg::JointCommandPubSubType> r4(p, "JointCommand", chain, recorder);
+    Subscription<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> r5(p, "WbcDiagnostics", chain, recorder);
+    Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> r6(p, "OperatorCommand", "event_reader", recorder);
+    Subscription<msg::Disturbance, msg::DisturbancePubSubType> r7(p, "Disturbance", "event_reader", recorder);
+    services::announceReady("mft-record");
+    while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    // The supervisor stops every service at once when the simulator ends: the last tick's samples may still
+    // be on their way. Keep listening until the topics have been quiet for linger-ms (at most 1 s).
+    const auto steady = [] {
+      return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    };
+    const auto give_up = steady() + 1'000'000'000LL;
+    while (steady() < give_up && steady() - recorder.lastPushWallNs() < static_cast<std::int64_t>(linger_s * 1e9))
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }  // readers gone: no more pushes
+  recorder.stop();
+  const auto s = recorder.stats();
+  std::printf("mft-record: %llu objects, %llu ticks of GroundTruth, %llu dropped, %.2f MB in %zu piece(s): %s\n",
+              static_cast<unsigned long long>(s.objects), static_cast<unsigned long long>(s.topics[0].written),
+              static_cast<unsigned long long>(s.topics[0].dropped_queue + s.topics[0].tick_gaps),
+              static_cast<double>(s.compressed_bytes) / 1e6, s.pieces.size(), s.pieces.empty() ? "" : s.pieces.front().c_str());
+  writeSummary(cli.get("summary"), "{\"service\": \"mft-record\", \"file\": \"" + opt.output + "\", \"mode\": \"" +
+                                      md.mode + "\", " + recorder.summaryJson() + "}");
+  return s.error.empty() ? 0 : 1;
+}

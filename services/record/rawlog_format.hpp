@@ -1,0 +1,127 @@
+#pragma once
+// The mft rawlog format, schema version 1 (docs/recording.md, shared/design/RAWLOG.md): an MRPT
+// observations-only rawlog ("format #2") whose first object is a CObservationComment holding the run's
+// metadata as YAML, followed by standard MRPT observations, one or more per DDS message:
+//   CObservationRawDAQ (AIN_double, channel 0 = tick or seq) for joints, contacts, references, commands,
+//   diagnostics and events; CObservationIMU for the torso IMU (`imu`) and, as a derived "virtual INS" view,
+//   the estimated floating base (`base_est`).
+// Observation timestamps are the simulator's clock: time_base_unix_ns + stamp_ns (100 ns resolution).
+// Only this file knows the channel layout: the recorder, replay and export all go through it, so the
+// reader and writer cannot disagree. Never reorder channels without bumping kSchemaVersion.
+#include <mrpt/obs/CObservation.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "MftMsgs.h"
+
+namespace mft::rawlog {
+
+constexpr int kSchemaVersion = 1;
+constexpr const char* kFormatName = "mft-rawlog";
+
+// The recorded topics, in the order messages of one tick are written (the simulator's outputs first).
+enum class Topic : std::uint8_t {
+  GroundTruth = 0,
+  SensorData,
+  RobotState,
+  Reference,
+  JointCommand,
+  WbcDiagnostics,
+  OperatorCommand,
+  Disturbance,
+};
+constexpr std::size_t kNumTopics = 8;
+const char* topicName(Topic t);
+bool parseTopic(const std::string& name, Topic* out);
+// Topics whose messages carry tick and stamp_ns (the others are events, stamped on arrival).
+inline bool hasTick(Topic t) { return t <= Topic::WbcDiagnostics; }
+
+// Variant index == Topic value.
+using Message = std::variant<msg::GroundTruth, msg::SensorData, msg::RobotState, msg::Reference, msg::JointCommand,
+                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance>;
+inline Topic topicOf(const Message& m) { return static_cast<Topic>(m.index()); }
+// tick (or seq for events) and stamp_ns of a message (0 for events).
+std::uint64_t tickOf(const Message& m);
+std::uint64_t stampOf(const Message& m);
+
+enum class LabelClass { RawDaq, Imu };
+struct LabelSpec {
+  std::string label;  // the observation's sensorLabel (also the CSV file name)
+  Topic topic;
+  LabelClass cls;
+  std::vector<std::string> columns;  // RawDAQ: AIN_double channels; IMU: the exported fields
+  std::vector<std::string> units;
+  std::string description;
+};
+// Every label of schema 1, in writing order (the labels of one topic are contiguous).
+const std::vector<LabelSpec>& labels();
+int labelIndex(const std::string& label);  // -1 if unknown
+// The label indices of one topic, in writing order.
+const std::vector<int>& topicLabels(Topic t);
+
+// TTimeStamp <-> UNIX nanoseconds (integer math: never through double, RAWLOG.md 2.4).
+mrpt::Clock::time_point toMrptTime(std::int64_t unix_ns);
+std::int64_t fromMrptTime(mrpt::Clock::time_point t);
+
+// Preallocated observations, one per label, reused for every message (the writer never allocates per tick).
+class ObservationEncoder {
+ public:
+  ObservationEncoder();
+  // Fills the observations of `m`'s topic with its content stamped `unix_ns`; returns their label indices.
+  const std::vector<int>& encode(const Message& m, std::int64_t unix_ns);
+  const mrpt::obs::CObservation& observation(int label_index) const { return *obs_[static_cast<std::size_t>(label_index)]; }
+
+ private:
+  std::vector<mrpt::obs::CObservation::Ptr> obs_;
+};
+
+// Reassembles messages from consecutive observations: a message is complete when every label of its topic
+// has been seen with the same timestamp. `time_base_unix_ns` comes from the metadata.
+class MessageAssembler {
+ public:
+  explicit MessageAssembler(std::int64_t time_base_unix_ns) : time_base_ns_(time_base_unix_ns) {}
+  // Returns true and sets *out when `obs` completes a message. Unknown labels are ignored (counted).
+  bool add(const mrpt::obs::CObservation& obs, Message* out, std::int64_t* unix_ns);
+  std::uint64_t incomplete() const { return incomplete_; }
+  std::uint64_t unknown() const { return unknown_; }
+
+ private:
+  struct Partial {
+    Message msg;
+    std::int64_t unix_ns = 0;
+    std::uint32_t seen = 0;  // bit per label position within the topic
+    bool active = false;
+  };
+  std::int64_t time_base_ns_;
+  std::array<Partial, kNumTopics> partial_{};
+  std::uint64_t incomplete_ = 0, unknown_ = 0;
+};
+
+// Values of one observation as named columns (the CSV export): RawDAQ channels, or the IMU fields of the label.
+bool observationValues(const mrpt::obs::CObservation& obs, int label_index, std::vector<double>* values);
+
+// ---- metadata ----
+struct Metadata {
+  std::string format;
+  int schema_version = 0;
+  std::string created_utc;
+  std::string mode;          // lockstep | realtime
+  int domain = -1;
+  std::string scenario_file, scenario_name, controller;
+  std::string robot_checksum;
+  std::int64_t time_base_unix_ns = 0;  // observation timestamp = time_base + stamp_ns
+  int piece = 0;
+  std::map<std::string, std::string> config;  // file name (robot.yaml, ..., scenario, terrain/<x>.yaml) -> text
+  std::string text;          // the YAML as stored
+};
+// YAML text of the metadata comment (labels, columns and units included).
+std::string metadataYaml(const Metadata& m);
+// Parses the comment text; throws std::runtime_error with a clear message if it is not mft metadata.
+Metadata parseMetadata(const std::string& text);
+
+}  // namespace mft::rawlog

@@ -111,8 +111,8 @@ std::string RawlogReader::endMessage() const {
     case End::Clean: return "complete (" + n + ")";
     case End::Truncated: return "truncated: " + end_detail_ + "; " + n + " (everything up to the last whole record)";
     case End::Corrupt:
-      return "corrupt after " + n + " (at about byte " + std::to_string(stream_.compressedPosition()) + " of " +
-             std::to_string(stream_.fileSize()) + "): " + end_detail_;
+      return "corrupt after " + n + " (" + std::to_string(stream_.getPosition()) +
+             " bytes decompressed): " + end_detail_;
   }
   return "";
 }

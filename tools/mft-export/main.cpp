@@ -1,0 +1,211 @@
+// mft-export: an mft rawlog to full-precision CSV (one file per label, named columns, %.17g), a summary of
+// what a file holds (--info), or paper-style figures (--plot: CSV + tools/mft-export/mft-plot.py).
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <vector>
+
+#include "services/record/rawlog_reader.hpp"
+#include "services/runtime/process.hpp"
+
+using namespace mft;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kExitBadInput = 2;
+constexpr int kExitCorrupt = 4;
+
+std::string takeFile(int* argc, char** argv) {
+  if (*argc < 2 || std::string(argv[1]).rfind("--", 0) == 0) return "";
+  std::string f = argv[1];
+  for (int i = 1; i + 1 < *argc; ++i) argv[i] = argv[i + 1];
+  --*argc;
+  return f;
+}
+
+std::string jsonEscape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o;
+}
+
+struct LabelInfo {
+  std::uint64_t count = 0;
+  std::int64_t first_ns = 0, last_ns = 0;  // simulator time (stamp_ns)
+  double first_tick = -1, last_tick = -1;
+  std::uint64_t tick_gaps = 0, tick_repeats = 0;
+  std::FILE* csv = nullptr;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string file = takeFile(&argc, argv);
+  services::CommandLine cli(
+      "mft-export FILE",
+      "Export an mft rawlog: --csv DIR writes <DIR>/<label>.csv (stamp_ns, time_s, then the named channels at\n"
+      "full precision); --info summarises the file (labels, counts, ticks, how it ends); --plot DIR also draws\n"
+      "paper-style figures (floating base, hip angles, contact forces) with python3-matplotlib.\n"
+      "Exit status: 0 ok (also for a truncated file, with a warning), 2 not an mft rawlog / other schema /\n"
+      "bad option, 4 corrupt (exported up to the damage).");
+  cli.option("file", "the rawlog (or give it as the first argument)");
+  cli.option("csv", "write one CSV per label into this folder");
+  cli.option("labels", "comma-separated labels to export (default: all)");
+  cli.flag("info", "print what the file holds");
+  cli.option("plot", "write CSV into DIR/csv and figures (PNG) into DIR");
+  cli.flag("metadata", "print the metadata comment (YAML) and exit");
+  cli.flag("json", "print the summary as JSON");
+  cli.parse(argc, argv);
+  if (file.empty()) file = cli.get("file");
+  if (file.empty()) cli.fail("no rawlog given");
+  if (!cli.isSet("csv") && !cli.isSet("info") && !cli.isSet("plot") && !cli.isSet("metadata"))
+    cli.fail("nothing to do: give --csv DIR, --plot DIR, --info or --metadata");
+
+  std::unique_ptr<rawlog::RawlogReader> reader;
+  try {
+    reader = std::make_unique<rawlog::RawlogReader>(file);
+  } catch (const rawlog::NotMftRawlog& e) {
+    std::fprintf(stderr, "mft-export: refused: %s\n", e.what());
+    return kExitBadInput;
+  }
+  const auto& md = reader->metadata();
+  if (cli.isSet("metadata")) {
+    std::fputs(md.text.c_str(), stdout);
+    return 0;
+  }
+  std::string csv_dir = cli.get("csv");
+  if (cli.isSet("plot")) csv_dir = (fs::path(cli.get("plot")) / "csv").string();
+  std::set<std::string> only;
+  if (cli.isSet("labels")) {
+    std::stringstream ss(cli.get("labels"));
+    std::string l;
+    while (std::getline(ss, l, ','))
+      if (!l.empty()) {
+        if (rawlog::labelIndex(l) < 0) cli.fail("--labels: unknown label '" + l + "'");
+        only.insert(l);
+      }
+  }
+  if (!csv_dir.empty()) fs::create_directories(csv_dir);
+
+  const auto& specs = rawlog::labels();
+  std::vector<LabelInfo> info(specs.size());
+  std::uint64_t unknown = 0;
+  mrpt::obs::CObservation::Ptr obs;
+  std::vector<double> values;
+  std::int64_t last_unix_ns = 0, first_unix_ns = -1;
+  while (reader->next(&obs)) {
+    const int li = rawlog::labelIndex(obs->sensorLabel);
+    if (li < 0 || !rawlog::observationValues(*obs, li, &values)) {
+      ++unknown;
+      continue;
+    }
+    const auto& spec = specs[static_cast<std::size_t>(li)];
+    auto& in = info[static_cast<std::size_t>(li)];
+    const std::int64_t unix_ns = rawlog::fromMrptTime(obs->timestamp);
+    const std::int64_t stamp = unix_ns - md.time_base_unix_ns;
+    if (first_unix_ns < 0) first_unix_ns = unix_ns;
+    last_unix_ns = std::max(last_unix_ns, unix_ns);
+    if (in.count == 0) in.first_ns = stamp;
+    in.last_ns = stamp;
+    if (rawlog::hasTick(spec.topic) && spec.cls == rawlog::LabelClass::RawDaq) {
+      const double tick = values[0];
+      if (in.count == 0) in.first_tick = tick;
+      else if (tick == in.last_tick) ++in.tick_repeats;
+      else if (tick > in.last_tick + 1) in.tick_gaps += static_cast<std::uint64_t>(tick - in.last_tick - 1);
+      in.last_tick = tick;
+    }
+    ++in.count;
+    if (!csv_dir.empty() && (only.empty() || only.count(spec.label))) {
+      if (!in.csv) {
+        const std::string path = (fs::path(csv_dir) / (spec.label + ".csv")).string();
+        in.csv = std::fopen(path.c_str(), "w");
+        if (!in.csv) {
+          std::fprintf(stderr, "mft-export: cannot write %s\n", path.c_str());
+          return 1;
+        }
+        std::fputs("stamp_ns,time_s", in.csv);
+        for (const auto& c : spec.columns) std::fprintf(in.csv, ",%s", c.c_str());
+        std::fputc('\n', in.csv);
+      }
+      std::fprintf(in.csv, "%lld,%.9f", static_cast<long long>(stamp), static_cast<double>(stamp) * 1e-9);
+      for (double v : values) std::fprintf(in.csv, ",%.17g", v);
+      std::fputc('\n', in.csv);
+    }
+  }
+  for (auto& in : info)
+    if (in.csv) std::fclose(in.csv);
+
+  const bool json = cli.isSet("json");
+  if (json) {
+    std::string labels_json;
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const auto& in = info[i];
+      if (!in.count) continue;
+      char buf[400];
+      std::snprintf(buf, sizeof buf,
+                    "%s\"%s\": {\"topic\": \"%s\", \"count\": %llu, \"first_s\": %.9f, \"last_s\": %.9f, "
+                    "\"first_tick\": %.0f, \"last_tick\": %.0f, \"tick_gaps\": %llu, \"tick_repeats\": %llu}",
+                    labels_json.empty() ? "" : ", ", specs[i].label.c_str(), rawlog::topicName(specs[i].topic),
+                    static_cast<unsigned long long>(in.count), static_cast<double>(in.first_ns) * 1e-9,
+                    static_cast<double>(in.last_ns) * 1e-9, in.first_tick, in.last_tick,
+                    static_cast<unsigned long long>(in.tick_gaps), static_cast<unsigned long long>(in.tick_repeats));
+      labels_json += buf;
+    }
+    std::printf("{\"file\": \"%s\", \"format\": \"%s\", \"schema_version\": %d, \"scenario\": \"%s\", \"mode\": \"%s\", "
+                "\"controller\": \"%s\", \"created_utc\": \"%s\", \"robot_checksum\": \"%s\", \"piece\": %d, "
+                "\"time_base_unix_ns\": %lld, \"first_unix_s\": %.6f, \"last_unix_s\": %.6f, \"file_bytes\": %llu, "
+                "\"objects\": %llu, \"unknown_objects\": %llu, \"labels\": {%s}, \"end\": \"%s\", "
+                "\"end_message\": \"%s\", \"csv_dir\": \"%s\"}\n",
+                jsonEscape(file).c_str(), md.format.c_str(), md.schema_version, md.scenario_name.c_str(), md.mode.c_str(),
+                md.controller.c_str(), md.created_utc.c_str(), md.robot_checksum.c_str(), md.piece,
+                static_cast<long long>(md.time_base_unix_ns), first_unix_ns < 0 ? 0.0 : static_cast<double>(first_unix_ns) * 1e-9,
+                static_cast<double>(last_unix_ns) * 1e-9, static_cast<unsigned long long>(reader->fileSize()),
+                static_cast<unsigned long long>(reader->objects()), static_cast<unsigned long long>(unknown),
+                labels_json.c_str(), rawlog::toString(reader->end()), jsonEscape(reader->endMessage()).c_str(),
+                jsonEscape(csv_dir).c_str());
+  } else {
+    std::printf("file       %s (%.2f MB, schema %d, piece %d)\n", file.c_str(), static_cast<double>(reader->fileSize()) / 1e6,
+                md.schema_version, md.piece);
+    std::printf("run        %s, %s, controller %s, recorded %s, robot %s\n", md.scenario_name.c_str(), md.mode.c_str(),
+                md.controller.c_str(), md.created_utc.c_str(), md.robot_checksum.c_str());
+    std::printf("%-16s %-16s %8s %12s %12s %10s %10s %6s\n", "label", "topic", "count", "first [s]", "last [s]",
+                "first tick", "last tick", "gaps");
+    for (std::size_t i = 0; i < specs.size(); ++i) {
+      const auto& in = info[i];
+      if (!in.count) continue;
+      std::printf("%-16s %-16s %8llu %12.3f %12.3f %10.0f %10.0f %6llu\n", specs[i].label.c_str(),
+                  rawlog::topicName(specs[i].topic), static_cast<unsigned long long>(in.count),
+                  static_cast<double>(in.first_ns) * 1e-9, static_cast<double>(in.last_ns) * 1e-9, in.first_tick,
+                  in.last_tick, static_cast<unsigned long long>(in.tick_gaps));
+    }
+    std::printf("end        %s\n", reader->endMessage().c_str());
+    if (!csv_dir.empty()) std::printf("csv        %s\n", csv_dir.c_str());
+  }
+  if (reader->end() == rawlog::RawlogReader::End::Truncated)
+    std::fprintf(stderr, "mft-export: the file is truncated: read up to its last whole record\n");
+  if (cli.isSet("plot") && reader->end() != rawlog::RawlogReader::End::Corrupt) {
+    const std::string cmd = "/usr/bin/python3 '" + std::string(MFT_PLOT_SCRIPT) + "' '" + csv_dir + "' '" +
+                            cli.get("plot") + "'" + (json ? " >&2" : "");
+    const int rc = std::system(cmd.c_str());
+    if (rc != 0) {
+      std::fprintf(stderr, "mft-export: plotting failed (%s)\n", cmd.c_str());
+      return 1;
+    }
+  }
+  if (reader->end() == rawlog::RawlogReader::End::Corrupt) {
+    std::fprintf(stderr, "mft-export: the file is %s\n", reader->endMessage().c_str());
+    return kExitCorrupt;
+  }
+  return 0;
+}

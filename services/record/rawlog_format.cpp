@@ -77,9 +77,11 @@ std::vector<LabelSpec> makeLabels() {
                withTick({"step_index", "phase", "stance_leg", "in_stance_right", "in_stance_left", "base_z", "base_zd",
                          "base_zdd", "pitch", "pitchd", "pitchdd", "foot_x_right", "foot_z_right", "foot_x_left",
                          "foot_z_left", "foot_vx_right", "foot_vz_right", "foot_vx_left", "foot_vz_left",
-                         "foot_ax_right", "foot_az_right", "foot_ax_left", "foot_az_left"}),
+                         "foot_ax_right", "foot_az_right", "foot_ax_left", "foot_az_left", "base_x", "base_xd",
+                         "base_xdd", "hold_base_x"}),
                unitsWithTick({"-", "-", "-", "0/1", "0/1", "m", "m/s", "m/s^2", "rad", "rad/s", "rad/s^2", "m", "m", "m",
-                              "m", "m/s", "m/s", "m/s", "m/s", "m/s^2", "m/s^2", "m/s^2", "m/s^2"}),
+                              "m", "m/s", "m/s", "m/s", "m/s", "m/s^2", "m/s^2", "m/s^2", "m/s^2", "m", "m/s", "m/s^2",
+                              "0/1"}),
                "planner reference (stance_leg 0 right, 1 left, -1 double support)"});
   // JointCommand
   l.push_back({"joint_tau_cmd", Topic::JointCommand, LabelClass::RawDaq,
@@ -168,6 +170,8 @@ void toChannels(const Message& m, const std::string& label, double* p) {
       put(p, r.foot_pos());
       put(p, r.foot_vel());
       put(p, r.foot_acc());
+      put(p, r.base_x());
+      *p++ = b2d(r.hold_base_x());
       break;
     }
     case Topic::JointCommand: {
@@ -269,6 +273,8 @@ void fromChannels(const std::string& label, const double* p, Message* m) {
       get(p, r.foot_pos());
       get(p, r.foot_vel());
       get(p, r.foot_acc());
+      get(p, r.base_x());
+      r.hold_base_x(d2b(*p++));
       break;
     }
     case Topic::JointCommand: {

@@ -174,7 +174,9 @@ void Recorder::writeSample(const Sample& s) {
   const auto stamp = static_cast<std::int64_t>(s.stamp_ns);
   if (!have_time_base_) {
     // Stamps are wall clock at the first sample + simulator time (RAWLOG.md 2.4: never UNIX 0), whole ms.
-    opt_.metadata.time_base_unix_ns = (unixNs() - stamp) / 1'000'000 * 1'000'000;
+    // From the sample's arrival, not from now: it may have waited in the reorder window.
+    const std::int64_t arrival_unix = unixNs() - (steadyNs() - s.arrival_ns);
+    opt_.metadata.time_base_unix_ns = (arrival_unix - stamp) / 1'000'000 * 1'000'000;
     have_time_base_ = true;
   }
   const bool split_due = (opt_.split_mb > 0 && static_cast<double>(out_->stream.compressedBytes()) >= opt_.split_mb * 1e6) ||

@@ -54,6 +54,10 @@ const PlanOutput& MotionPlanner::update(const PlannerState& s) {
   z_ref_ += dz;
   out_.base_z = {z_ref_, dt > 0.0 ? dz / dt : 0.0, 0.0};
   out_.base_pitch.setZero();
+  // Standing: base x over the midpoint of the stance feet (a double-support task; the paper's eq. 12 plans only
+  // z and pitch, and with both feet down nothing else would stop the base drifting).
+  out_.base_x = {0.5 * (hold_[0].x() + hold_[1].x()), 0.0, 0.0};
+  out_.hold_base_x = cmd.mode == LocomotionMode::Stand && !schedule_.inSwing();
 
   for (int leg = 0; leg < model::kNumLegs; ++leg) {
     FootReference& f = out_.foot[leg];

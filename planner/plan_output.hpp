@@ -31,6 +31,10 @@ struct PlanOutput {
   LocomotionMode mode = LocomotionMode::Stand;
   Eigen::Vector3d base_z{0, 0, 0};      // eq. 12: [pos, vel, acc] of the base height
   Eigen::Vector3d base_pitch{0, 0, 0};  // eq. 12: [pos, vel, acc] of the pitch (always 0)
+  // Not in the paper (it leaves base x passive, stepping stabilises it): standing in double support, the base x
+  // is held at the midpoint of the two stance feet. base_x is always filled; hold_base_x says when it applies.
+  Eigen::Vector3d base_x{0, 0, 0};      // [pos, vel, acc] of the base (hip axis) x
+  bool hold_base_x = false;             // Stand mode and both feet in stance
   std::array<FootReference, model::kNumLegs> foot{};
 
   // Eq. 13 diagnostics of the current swing (zero when standing).

@@ -13,6 +13,8 @@ inline WbcReference referenceFromPlan(const planner::PlanOutput& plan) {
   for (int leg = 0; leg < model::kNumLegs; ++leg) ref.foot_in_stance[leg] = plan.foot[leg].stance;
   ref.base_z = {plan.base_z[0], plan.base_z[1], plan.base_z[2]};
   ref.base_pitch = {plan.base_pitch[0], plan.base_pitch[1], plan.base_pitch[2]};
+  ref.base_x = {plan.base_x[0], plan.base_x[1], plan.base_x[2]};
+  ref.hold_base_x = plan.hold_base_x;
   ref.foot_pos = plan.footPos();
   ref.foot_vel = plan.footVel();
   ref.foot_acc = plan.footAcc();

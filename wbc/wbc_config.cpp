@@ -50,12 +50,14 @@ WbcConfig read(StrictNode& root) {
   c.weights.contact_force_rate = w.nonNegative("contact_force_rate");
   c.weights.slack = w.positive("slack");
   c.weights.qdd_regularization = w.positive("qdd_regularization");
+  c.weights.base_x = w.nonNegative("base_x");
 
   auto& g = root.child("gains");
   c.gains.base_z = readGains1(g.child("base_z"));
   c.gains.base_pitch = readGains1(g.child("base_pitch"));
   c.gains.swing_foot = readGains2(g.child("swing_foot"));
   c.gains.support_foot = readGains2(g.child("support_foot"));
+  c.gains.base_x = readGains1(g.child("base_x"));
 
   auto& l = root.child("limits");
   const auto qb = l.fixed<3>("qdd_base_max");

@@ -36,6 +36,8 @@ struct WbcWeights {  // paper Table I, plus the qdd regularization that keeps H 
   double contact_force_rate = 5.0e-2;
   double slack = 1.0e3;
   double qdd_regularization = 1.0e-3;
+  // Not in Table I: base x task, active only when standing in double support (WbcReference::hold_base_x).
+  double base_x = 1.0;
 };
 
 struct WbcGains {
@@ -43,6 +45,7 @@ struct WbcGains {
   PdGains1 base_pitch{400.0, 40.0};
   PdGains2 swing_foot{{400.0, 400.0}, {40.0, 40.0}};
   PdGains2 support_foot{{0.0, 0.0}, {20.0, 20.0}};
+  PdGains1 base_x{100.0, 20.0};  // standing only (see WbcWeights::base_x)
 };
 
 struct WbcLimits {

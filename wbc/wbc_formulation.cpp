@@ -27,6 +27,20 @@ Task baseCoordinateTask(const char* name, int index, double weight, const Setpoi
   });
 }
 
+// Base x task for standing: J = unit row, weight w_x only while the planner holds base x (Stand mode) and both
+// feet are in stance, 0 otherwise (stepping leaves base x passive, as in the paper).
+Task baseXTask(double weight) {
+  return Task("base_x", VarBlock::Qdd, 1, 0.0, [weight](const TickContext& c, Task* t) {
+    const bool active = c.ref->hold_base_x && c.ref->foot_in_stance[0] && c.ref->foot_in_stance[1];
+    t->weight = active ? weight : 0.0;
+    t->A.setZero();
+    t->A(0, model::kBaseX) = 1.0;
+    t->b(0) = active ? pdAcceleration(c.ref->base_x, c.state->q[model::kBaseX], c.state->qd[model::kBaseX],
+                                      c.params->gains.base_x)
+                     : 0.0;
+  });
+}
+
 // Foot point task: J_c rows of the foot; swing or support weight and gains from the contact schedule.
 Task footTask(const char* name, int leg) {
   return Task(name, VarBlock::Qdd, 2, 0.0, [leg](const TickContext& c, Task* t) {
@@ -111,6 +125,9 @@ Formulation buildFormulation(const WbcParams& params) {
   // Not in the paper: a small ||qdd||^2 term. The tasks above constrain only 6 of the 11 accelerations; the
   // rest would be fixed by the equalities alone, and the dual active-set solver needs H positive definite.
   f.tasks.push_back(identityTask("qdd_regularization", VarBlock::Qdd, w.qdd_regularization, false));
+  // Not in the paper: base x while standing in double support (eq. 12 plans only z and pitch). Last, so the
+  // indices of the paper's terms stay as they were.
+  f.tasks.push_back(baseXTask(w.base_x));
 
   // --- Constraints, eq. 16 and the loop closure ---
   using Type = Constraint::Type;

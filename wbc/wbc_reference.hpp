@@ -25,6 +25,10 @@ struct WbcReference {
   model::VectorC foot_pos = model::VectorC::Zero();
   model::VectorC foot_vel = model::VectorC::Zero();
   model::VectorC foot_acc = model::VectorC::Zero();
+  // Base x (hip axis, world) [m, m/s, m/s^2], tracked only when hold_base_x and both feet are in stance
+  // (standing; not in the paper, where base x is passive).
+  Setpoint1 base_x;
+  bool hold_base_x = false;
 
   bool allFinite() const;
 };

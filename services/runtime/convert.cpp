@@ -104,6 +104,8 @@ void toMsg(const planner::PlanOutput& in, msg::Reference* out) {
   copyOut(r.foot_pos, &out->foot_pos());
   copyOut(r.foot_vel, &out->foot_vel());
   copyOut(r.foot_acc, &out->foot_acc());
+  out->base_x({r.base_x.pos, r.base_x.vel, r.base_x.acc});
+  out->hold_base_x(r.hold_base_x);
 }
 
 void fromMsg(const msg::Reference& in, wbc::WbcReference* out) {
@@ -114,6 +116,8 @@ void fromMsg(const msg::Reference& in, wbc::WbcReference* out) {
   copyIn(in.foot_pos(), &out->foot_pos);
   copyIn(in.foot_vel(), &out->foot_vel);
   copyIn(in.foot_acc(), &out->foot_acc);
+  out->base_x = {in.base_x()[0], in.base_x()[1], in.base_x()[2]};
+  out->hold_base_x = in.hold_base_x();
 }
 
 }  // namespace mft::services

@@ -53,6 +53,7 @@ Scenario read(StrictNode& root) {
   if (s.terrain.empty() || s.terrain.find('/') != std::string::npos)
     root.fail("terrain", "expected a terrain name from config/terrain/ (no path)");
   s.initial_base_height_m = root.inRange("initial_base_height_m", 0.1, 1.0);
+  s.initial_stance_width_m = root.has("initial_stance_width_m") ? root.inRange("initial_stance_width_m", 0.0, 0.4) : 0.0;
   auto& fall = root.child("fall");
   s.fall_base_height_m = fall.inRange("base_height_below_m", 0.0, 1.0);
   s.fall_pitch_rad = fall.inRange("pitch_beyond_rad", 0.0, 3.2);
@@ -119,6 +120,7 @@ std::string Scenario::toJson() const {
   o << "{\"name\": \"" << esc(name) << "\", \"file\": \"" << esc(source_file) << "\", \"duration_s\": " << duration_s
     << ", \"controller\": \"" << controller << "\", \"estimator\": \"" << estimator << "\", \"terrain\": \""
     << esc(terrain) << "\", \"initial_base_height_m\": " << initial_base_height_m
+    << ", \"initial_stance_width_m\": " << initial_stance_width_m
     << ", \"fall\": {\"base_height_below_m\": " << fall_base_height_m << ", \"pitch_beyond_rad\": " << fall_pitch_rad
     << "}, \"commands\": [";
   for (std::size_t i = 0; i < commands.size(); ++i)

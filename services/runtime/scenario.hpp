@@ -33,6 +33,9 @@ struct Scenario {
   std::string estimator;    // kalman | ground_truth
   std::string terrain;      // a file name in config/terrain/ without .yaml
   double initial_base_height_m = 0.0;
+  // Distance between the feet at the start, right foot ahead, centred under the base [m]. Optional key
+  // (default 0: both feet under the hip axis, a point support that suits stepping but not standing).
+  double initial_stance_width_m = 0.0;
   std::vector<ScenarioCommand> commands;  // sorted by time, the first at 0
   std::vector<ScenarioPush> pushes;
   double fall_base_height_m = 0.0;        // the run counts as a fall below this base height

@@ -96,6 +96,8 @@ int main(int argc, char** argv) {
   sim::Simulator simulator(ctx.robot(), options, terrain);
   sim::StandingPose pose;
   pose.base_height_m = scenario.initial_base_height_m;
+  // The scenario's initial stance width, right foot ahead (0: both feet under the hip axis).
+  pose.foot_offset_x_m = {0.5 * scenario.initial_stance_width_m, -0.5 * scenario.initial_stance_width_m};
   simulator.reset(pose);
   // Pushes at a time go to the simulator now; a push at a lift-off is armed only from its time on (the
   // simulator triggers at the next lift-off after it is scheduled).

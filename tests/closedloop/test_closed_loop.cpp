@@ -81,20 +81,20 @@ TEST(Walking, TracksTheAverageSpeedCommand) {
   expectEstimatorTracksTruth(s);
 }
 
-// Requirement: stand 10 s at 0.40 m, height error < 5 mm after settling, |pitch| < 0.01 rad. NOT MET (disabled,
-// see docs/closed-loop.md): with both feet under the hip (mft-sim's start) the support is a point and the robot
-// tips after ~4 s; with the feet 0.12 m apart the base still drifts forward (no task acts on base x in Problem 1)
-// and falls after ~5 s. Run with --gtest_also_run_disabled_tests to measure.
-TEST(Standing, DISABLED_HoldsHeightAndPitchFor10s) {
+// Requirement: stand 10 s at 0.40 m, height error < 5 mm after settling, |pitch| < 0.01 rad. Starts like
+// config/scenarios/stand.yaml (feet 0.12 m apart); the WBC holds base x over the feet in double support.
+TEST(Standing, HoldsHeightAndPitchFor10s) {
   RunOptions o;
   o.stats_from_s = 2.0;
-  o.foot_offset_x_m = {0.06, -0.06};
-  ClosedLoop loop(configs(), makeScenario(0.40, 0.0, 10.0, "mft", "kalman", 0.0, true), o);
+  const services::Scenario sc = makeScenario(0.40, 0.0, 10.0, "mft", "kalman", 0.0, true);
+  ASSERT_DOUBLE_EQ(sc.initial_stance_width_m, kStandStanceWidth);
+  ClosedLoop loop(configs(), sc, o);
   const RunSummary s = loop.run();
   std::printf("%s\n", s.toJson().c_str());
   ASSERT_FALSE(s.fell) << s.fall_reason << " at " << s.fall_time_s << " s";
   EXPECT_LT(s.max_abs_base_z_error, 0.005);
   EXPECT_LT(s.max_abs_pitch, 0.01);
+  EXPECT_LT(std::abs(s.average_speed), 1e-3);  // no drift
 }
 
 }  // namespace

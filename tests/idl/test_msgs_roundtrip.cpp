@@ -65,6 +65,8 @@ TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
   mft::msg::Reference ref;
   ref.stance_leg(-1);
   ref.foot_acc()[3] = 7.0;
+  ref.base_x()[0] = 0.03;
+  ref.hold_base_x(true);
   EXPECT_TRUE((roundTrip<mft::msg::Reference, mft::msg::ReferencePubSubType>(ref) == ref));
   mft::msg::WbcDiagnostics d;
   d.status(3);

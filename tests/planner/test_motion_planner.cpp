@@ -83,6 +83,30 @@ TEST(MotionPlanner, StandingHoldsBothFeetAndRampsTheHeight) {
   EXPECT_NEAR(out->base_z[1], 0.0, 1e-12);
   EXPECT_EQ(out->base_pitch.norm(), 0.0);
   EXPECT_EQ(out->step_index, 0u);
+  // Standing: base x held over the midpoint of the stance feet.
+  EXPECT_TRUE(out->hold_base_x);
+  EXPECT_NEAR(out->base_x[0], 0.005, 1e-12);
+  EXPECT_EQ(out->base_x[1], 0.0);
+  EXPECT_EQ(out->base_x[2], 0.0);
+}
+
+TEST(MotionPlanner, BaseXIsHeldOnlyWhenStandingInDoubleSupport) {
+  MotionPlanner planner(config(), robot());
+  IdealRobot r;
+  r.feet = {Eigen::Vector2d(0.06, 0.0), Eigen::Vector2d(-0.06, 0.0)};
+  EXPECT_TRUE(planner.update(r.state()).hold_base_x);
+  planner.setCommand({0.40, 0.0, LocomotionMode::StepInPlace});
+  for (int i = 0; i < 1000; ++i) {
+    const PlanOutput& out = planner.update(r.state());
+    EXPECT_FALSE(out.hold_base_x);  // stepping: base x passive (paper)
+    r.step(out);
+  }
+  planner.setCommand({0.40, 0.0, LocomotionMode::Stand});
+  for (int i = 0; i < 500; ++i) r.step(planner.update(r.state()));
+  const PlanOutput& out = planner.output();
+  ASSERT_EQ(out.stance_leg, -1);
+  EXPECT_TRUE(out.hold_base_x);
+  EXPECT_NEAR(out.base_x[0], 0.5 * (r.feet[0].x() + r.feet[1].x()), 1e-12);
 }
 
 TEST(MotionPlanner, SwingStartsAtLiftoffAndEndsAtTheEq13Target) {

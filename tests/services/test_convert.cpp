@@ -88,6 +88,8 @@ TEST(Convert, PlanToWbcReference) {
   p.foot[1].vel = {0.5, 0.2};
   p.foot[1].acc = {-3.0, 1.0};
   p.stance_leg = 0;
+  p.base_x = {0.01, -0.02, 0.3};
+  p.hold_base_x = true;
   msg::Reference m;
   services::toMsg(p, &m);
   EXPECT_EQ(m.stance_leg(), 0);
@@ -103,4 +105,14 @@ TEST(Convert, PlanToWbcReference) {
   EXPECT_EQ(r.foot_vel, p.footVel());
   EXPECT_EQ(r.foot_acc, p.footAcc());
   EXPECT_DOUBLE_EQ(r.foot_acc[2], -3.0);
+  EXPECT_DOUBLE_EQ(m.base_x()[0], 0.01);
+  EXPECT_TRUE(m.hold_base_x());
+  EXPECT_DOUBLE_EQ(r.base_x.pos, 0.01);
+  EXPECT_DOUBLE_EQ(r.base_x.vel, -0.02);
+  EXPECT_DOUBLE_EQ(r.base_x.acc, 0.3);
+  EXPECT_TRUE(r.hold_base_x);
+  p.hold_base_x = false;
+  services::toMsg(p, &m);
+  services::fromMsg(m, &r);
+  EXPECT_FALSE(r.hold_base_x);
 }

@@ -83,3 +83,14 @@ TEST(Scenario, PushWithBadLeg) {
 }
 TEST(Scenario, MalformedYaml) { EXPECT_THROW(parseScenario("name: [unclosed\n", "broken.yaml"), ConfigError); }
 TEST(Scenario, MissingFile) { EXPECT_THROW(loadScenario("/nonexistent/s.yaml"), ConfigError); }
+
+TEST(Scenario, InitialStanceWidthIsOptional) {
+  EXPECT_DOUBLE_EQ(parseScenario(stepText(), "step.yaml").initial_stance_width_m, 0.0);  // feet under the hip
+  const Scenario stand = loadScenario(scenarioDir() + "/stand.yaml");
+  EXPECT_DOUBLE_EQ(stand.initial_stance_width_m, 0.12);
+  EXPECT_NE(stand.toJson().find("\"initial_stance_width_m\": 0.12"), std::string::npos) << stand.toJson();
+}
+TEST(Scenario, InitialStanceWidthOutOfRange) {
+  expectError("initial_base_height_m: 0.42", "initial_base_height_m: 0.42\ninitial_stance_width_m: 0.6",
+              "initial_stance_width_m");
+}

@@ -57,7 +57,8 @@ Configs loadConfigs(const std::string& dir) {
 }
 
 services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
-                                const std::string& estimator, double step_at_s, bool stand_only) {
+                                const std::string& estimator, double step_at_s, bool stand_only,
+                                double stance_width_m) {
   services::Scenario s;
   s.name = stand_only ? "stand" : (speed_mps != 0.0 ? "walk" : "step-in-place");
   s.description = "built by mft-closedloop";
@@ -66,6 +67,7 @@ services::Scenario makeScenario(double height_m, double speed_mps, double durati
   s.estimator = estimator;
   s.terrain = "flat";
   s.initial_base_height_m = height_m;
+  s.initial_stance_width_m = stance_width_m >= 0.0 ? stance_width_m : (stand_only ? kStandStanceWidth : 0.0);
   s.fall_base_height_m = 0.25;  // the scenario files' values
   s.fall_pitch_rad = 0.8;
   s.commands.push_back({0.0, services::LocomotionMode::Stand, height_m, 0.0});
@@ -86,7 +88,8 @@ ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenari
   sim_ = std::make_unique<sim::Simulator>(configs_.robot, configs_.sim, terrain_);
   sim::StandingPose pose;
   pose.base_height_m = scenario_.initial_base_height_m;
-  pose.foot_offset_x_m = options_.foot_offset_x_m;
+  // mft-sim's start: the scenario's stance width, right foot ahead, centred under the base.
+  pose.foot_offset_x_m = {0.5 * scenario_.initial_stance_width_m, -0.5 * scenario_.initial_stance_width_m};
   sim_->reset(pose);
   estimator_ = std::make_unique<estimator::StateEstimator>(withMode(configs_.estimator, scenario_.estimator),
                                                            configs_.robot);

@@ -38,17 +38,18 @@ struct Configs {
 Configs loadConfigs(const std::string& config_dir);
 
 // A scenario built from a few numbers (no file): stand at `height_m` until `step_at_s`, then step in place
-// (speed 0) or walk (speed != 0) for the rest of `duration_s`.
+// (speed 0) or walk (speed != 0) for the rest of `duration_s`. The initial stance width (the scenario's
+// initial_stance_width_m, as mft-sim uses it) is kStandStanceWidth for a stand-only scenario (like
+// config/scenarios/stand.yaml), else 0 (both feet under the hip axis); a negative stance_width_m means that default.
+constexpr double kStandStanceWidth = 0.12;
 services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
-                                const std::string& estimator, double step_at_s = 1.0, bool stand_only = false);
+                                const std::string& estimator, double step_at_s = 1.0, bool stand_only = false,
+                                double stance_width_m = -1.0);
 
 struct RunOptions {
   bool stop_at_fall = true;
   // Statistics (the summary below) are taken over [stats_from_s, end]; the RunMonitor's settle time too.
   double stats_from_s = 2.0;
-  // Initial foot x offsets from the base [right, left]. mft-sim starts with both feet under the hip axis
-  // ({0, 0}): fine for stepping, but a point support for standing (SIM-ODE.md 3d stands with +-0.06 m).
-  std::array<double, model::kNumLegs> foot_offset_x_m{0.0, 0.0};
 };
 
 // Running figures over the statistics window (ground truth unless named estimator).

@@ -31,7 +31,8 @@ int main(int argc, char** argv) {
   cli.option("push", "a sagittal push on the torso [N s] (+ forward)");
   cli.option("push-at", "the push is armed at this time [s] and lands at the next right-foot lift-off", "5.0");
   cli.flag("push-timed", "apply the push at --push-at itself instead of at a lift-off");
-  cli.option("stance-width", "initial distance between the feet [m], right foot ahead (mft-sim: 0)", "0");
+  cli.option("stance-width", "initial distance between the feet [m], right foot ahead (default: the scenario's "
+             "initial_stance_width_m; without --scenario 0.12 with --stand, else 0)");
   cli.option("stats-from", "statistics window start [s]", "2.0");
   cli.flag("continue-after-fall", "keep running after a fall");
   cli.option("csv", "write a per-tick trace to this CSV file");
@@ -86,8 +87,7 @@ int main(int argc, char** argv) {
   closedloop::RunOptions options;
   options.stop_at_fall = !cli.isSet("continue-after-fall");
   options.stats_from_s = cli.getDouble("stats-from", 0.0, 3600.0);
-  const double width = cli.getDouble("stance-width", 0.0, 0.4);
-  options.foot_offset_x_m = {0.5 * width, -0.5 * width};
+  if (cli.isSet("stance-width")) scenario.initial_stance_width_m = cli.getDouble("stance-width", 0.0, 0.4);
   std::unique_ptr<closedloop::ClosedLoop> loop;
   try {
     loop = std::make_unique<closedloop::ClosedLoop>(configs, scenario, options);

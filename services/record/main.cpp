@@ -93,6 +93,15 @@ std::string threadCpuJson() {
   return j + buf;
 }
 
+// Sets the nice value of every thread of this process but `except_tid` (Linux: nice is per thread).
+void reniceThreads(long value, int except_tid) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc/self/task", ec)) {
+    const int tid = std::atoi(e.path().filename().c_str());
+    if (tid > 0 && tid != except_tid) setpriority(PRIO_PROCESS, static_cast<id_t>(tid), static_cast<int>(value));
+  }
+}
+
 bool pidAlive(long pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
 
 // After a crash the supervisor restarts the recorder with the same --output: continue in the next free piece
@@ -180,8 +189,12 @@ class Subscription : public dds::DataReaderListener {
   void on_data_available(dds::DataReader* reader) override {
     dds::SampleInfo info;
     while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) recorder_.push(rawlog::Message(sample_));
+      if (info.valid_data) {
+        recorder_.push(rawlog::Message(sample_));
+        received_.fetch_add(1, std::memory_order_relaxed);
+      }
   }
+  std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
 
  private:
   dds::Subscriber* subscriber_;
@@ -189,6 +202,7 @@ class Subscription : public dds::DataReaderListener {
   dds::Topic* topic_ = nullptr;
   dds::DataReader* reader_ = nullptr;
   Msg sample_;
+  std::atomic<std::uint64_t> received_{0};
 };
 
 }  // namespace
@@ -200,11 +214,11 @@ int main(int argc, char** argv) {
   services::ServiceContext::declareOptions(cli);
   cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>)", "", true);
   cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (RAWLOG.md)", "1");
-  cli.option("flush-ms", "flush period: a crash loses at most this much [ms]", "100");
+  cli.option("flush-ms", "flush period: a crash loses about this much [ms] (at most 100)", "50");
   cli.option("queue", "capacity of the queue between DDS and the writer [messages]", "65536");
   cli.option("split-mb", "start a new piece past this compressed size [MB] (0 = never)", "0");
   cli.option("split-s", "start a new piece every this many simulated seconds (0 = never)", "0");
-  cli.option("linger-ms", "on SIGTERM, keep receiving until the topics are quiet this long (at most 1 s)", "100");
+  cli.option("linger-ms", "on SIGTERM, keep receiving until the topics are quiet this long (at most 2 s)", "200");
   cli.option("nice", "niceness of the recorder without --rt (0 = none): the stack goes first", "10");
   cli.option("reader-qos", "best_effort: best-effort readers on the 1 kHz topics (measured: no losses with the\n"
              "                             large socket buffer, half the cost); profile: the chain's profile (reliable in lockstep)",
@@ -227,15 +241,8 @@ int main(int argc, char** argv) {
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
-  if (cli.isSet("rt")) {
-    services::tryRealtimeScheduling(80);
-  } else {
-    // Recording must not slow the stack: on a busy machine the control chain gets the CPU first, and the
-    // recorder catches up from its socket buffers and queue (set before any thread exists: threads inherit it).
-    const long nice_value = cli.getInt("nice", 0, 19);
-    if (nice_value > 0 && setpriority(PRIO_PROCESS, 0, static_cast<int>(nice_value)) != 0)
-      std::fprintf(stderr, "mft-record: warning: cannot lower the priority (nice %ld)\n", nice_value);
-  }
+  if (cli.isSet("rt")) services::tryRealtimeScheduling(80);
+  const long nice_value = cli.isSet("rt") ? 0 : cli.getInt("nice", 0, 19);
 
   rawlog::RecorderOptions opt;
   opt.output = fs::absolute(cli.get("output")).string();
@@ -305,13 +312,28 @@ int main(int argc, char** argv) {
     Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> r6(p, "OperatorCommand", "event_reader", recorder);
     Subscription<msg::Disturbance, msg::DisturbancePubSubType> r7(p, "Disturbance", "event_reader", recorder);
     services::announceReady("mft-record");
-    while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    // Recording must not slow the stack: once every 1 kHz topic flows (discovery done at full priority, so
+    // the first ticks are not missed), the DDS threads drop to --nice and the stack gets the CPU first on a
+    // busy machine; the recorder catches up from its socket buffers. The writer thread stays at nice 0.
+    bool reniced = nice_value == 0;
+    auto flowing = [&] { return r0.received() && r1.received() && r2.received() && r3.received() && r4.received() && r5.received(); };
+    while (!services::shutdownRequested()) {
+      if (!reniced && flowing()) {
+        reniceThreads(nice_value, recorder.writerThreadId());
+        reniced = true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    // Back to full priority to drain what is still in the socket buffers, then keep listening until the
+    // topics have been quiet for linger-ms (at most 2 s): the supervisor stops every service at once when
+    // the simulator ends, and the last tick's samples may still be on their way.
+    if (nice_value != 0) reniceThreads(0, recorder.writerThreadId());
     // The supervisor stops every service at once when the simulator ends: the last tick's samples may still
     // be on their way. Keep listening until the topics have been quiet for linger-ms (at most 1 s).
     const auto steady = [] {
       return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
     };
-    const auto give_up = steady() + 1'000'000'000LL;
+    const auto give_up = steady() + 2'000'000'000LL;
     while (steady() < give_up && steady() - recorder.lastPushWallNs() < static_cast<std::int64_t>(linger_s * 1e9))
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     cpu_json = threadCpuJson();  // while the DDS threads still exist

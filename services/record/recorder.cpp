@@ -4,6 +4,8 @@
 #include <mrpt/serialization/CArchive.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -95,10 +97,18 @@ void Recorder::stop() {
 }
 
 void Recorder::writerLoop() {
-  // gzip calls stall for up to milliseconds (RAWLOG.md decision 4): keep this thread at normal priority even
-  // when the service runs SCHED_FIFO (its DDS threads inherit that, and they only copy into the queue).
-  sched_param sp{};
-  pthread_setschedparam(pthread_self(), SCHED_OTHER, &sp);
+  // gzip calls stall for up to milliseconds (RAWLOG.md decision 4). Under SCHED_FIFO (realtime stacks) this
+  // thread runs at FIFO priority 1: below every control thread (80), which it never delays, yet above the
+  // machine's ordinary load, which could otherwise starve it past the flush period (crash loss). Otherwise at
+  // nice 0 even if the service is niced: it needs little CPU, but promptly.
+  writer_tid_ = static_cast<int>(syscall(SYS_gettid));
+  if (sched_getscheduler(0) == SCHED_FIFO) {
+    sched_param sp{};
+    sp.sched_priority = 1;
+    pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  } else {
+    setpriority(PRIO_PROCESS, static_cast<id_t>(writer_tid_.load()), 0);
+  }
   try {
     while (true) {
       const bool stopping = stop_.load();

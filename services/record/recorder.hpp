@@ -69,6 +69,7 @@ class Recorder {
   void stop();
   RecorderStats stats() const;
   std::int64_t lastPushWallNs() const { return last_push_ns_.load(); }
+  int writerThreadId() const { return writer_tid_.load(); }
   // JSON object with the counters (for the service summary).
   std::string summaryJson() const;
 
@@ -98,6 +99,7 @@ class Recorder {
   std::atomic<std::uint64_t> newest_stamp_{0};
   std::atomic<std::int64_t> last_push_ns_{0};
   std::atomic<bool> stop_{false};
+  std::atomic<int> writer_tid_{0};
   std::thread writer_;
   bool started_ = false, stopped_ = false;
 

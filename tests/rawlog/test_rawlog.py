@@ -1,0 +1,334 @@
+#!/usr/bin/env python3
+"""Recording and replay integration tests (issue 8): real mft-sim, mft-estimator, mft-planner, mft-wbc and
+mft-record processes started through services/mft-supervisor, each on a DDS domain of its own, bounded in
+time, every process cleaned up even on failure. The figures the issue asks for (overhead, file size,
+throughput, replay lateness, crash loss) are printed to stderr and collected in a JSON report
+($MFT_RAWLOG_REPORT, default <tmp>/rawlog-report.json). Needs MFT_BIN_DIR (set by CTest)."""
+import gzip
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+SCENARIOS = REPO / "config" / "scenarios"
+# Own domain block (the stack tests use 100..219): parallel CTest runs never meet.
+DOMAIN_BASE = 10 + (os.getpid() % 20) * 4
+TICK_LABELS = ["gt_q", "gt_qd", "contact_force", "leg_lti", "joint_q", "joint_qd", "joint_tau_meas", "imu",
+               "foot_switch", "est_q", "est_qd", "est_contact", "base_est", "plan_ref", "joint_tau_cmd", "wbc_diag"]
+TICK_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
+REPORT = {}
+
+
+def report(key, value):
+    REPORT[key] = value
+    print(f"\n[rawlog] {key}: {json.dumps(value)}", file=sys.stderr, flush=True)
+
+
+def run(cmd, timeout=300, **kw):
+    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=timeout, **kw)
+
+
+class Tmp:
+    """One temporary folder and the supervisor runs of a test class, cleaned up whatever happens."""
+
+    def __init__(self):
+        self.path = Path(tempfile.mkdtemp(prefix="mft-rawlog-test-"))
+        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.path / "runs"))
+        self.procs = []
+        self.domains_up = []
+
+    def supervisor(self, *args, timeout=300):
+        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
+        if args[0] in ("run", "up"):
+            cmd += ["--bin-dir", str(BIN)]
+        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        out, err = p.communicate(timeout=timeout)
+        return p.returncode, out, err
+
+    def run_stack(self, domain, record=None, scenario="step-in-place.yaml"):
+        extra = ["--record", record] if record else []
+        code, out, err = self.supervisor("run", SCENARIOS / scenario, "--domain", domain, "--json",
+                                         "--run-dir", self.path / f"run-{domain}-{time.monotonic_ns()}", *extra)
+        try:
+            return code, json.loads(out), err
+        except ValueError:
+            raise AssertionError(f"no JSON summary (exit {code}): {err[-3000:]}")
+
+    def cleanup(self):
+        for d in self.domains_up:
+            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
+                           capture_output=True, timeout=60)
+        for p in self.procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+        shutil.rmtree(self.path, ignore_errors=True)
+
+
+class RecordedLockstepRun(unittest.TestCase):
+    """One 10 s lockstep run of step-in-place with --record, shared by the checks below."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = Tmp()
+        try:
+            cls.rawlog = cls.tmp.path / "step.rawlog"
+            cls.code, cls.summary, cls.err = cls.tmp.run_stack(DOMAIN_BASE, record=cls.rawlog)
+        except BaseException:
+            cls.tmp.cleanup()
+            raise
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def info(self, path):
+        p = run([BIN / "mft-export", path, "--info", "--json"])
+        return p.returncode, (json.loads(p.stdout) if p.stdout.strip() else None), p.stderr
+
+    def test_1_run_recorded_every_tick_without_drops(self):
+        self.assertEqual(self.code, 0, self.err[-3000:])
+        s = self.summary
+        self.assertTrue(s["ok"])
+        self.assertEqual(s["record"], str(self.rawlog.resolve()))
+        self.assertEqual(s["ticks"], 10000)
+        rec = s["services"]["mft-record"]
+        self.assertEqual(rec["dropped_samples"], 0, rec)
+        for topic in TICK_TOPICS:
+            t = rec["topics"][topic]
+            self.assertEqual((t["written"], t["first"], t["last"], t["tick_gaps"], t["dropped_queue"]),
+                             (10000, 0, 9999, 0, 0), (topic, t))
+        code, info, err = self.info(self.rawlog)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(info["end"], "complete")
+        self.assertEqual(info["schema_version"], 1)
+        for label in TICK_LABELS:
+            lab = info["labels"][label]
+            self.assertEqual(lab["count"], 10000, label)
+            if label not in ("imu", "base_est"):
+                self.assertEqual((lab["first_tick"], lab["last_tick"], lab["tick_gaps"]), (0, 9999, 0), label)
+        sidecar = Path(str(self.rawlog) + ".yaml").read_text()
+        self.assertIn("status: complete", sidecar)
+        self.assertIn("wbc.yaml: |", sidecar)
+        size_mb = self.rawlog.stat().st_size / 1e6
+        report("recording", {"file_MB_per_10s": round(size_mb, 3), "MB_per_minute": round(size_mb * 6, 2),
+                             "GB_per_hour": round(size_mb * 0.36, 2), "objects": rec["objects"],
+                             "uncompressed_MB": round(rec["uncompressed_bytes"] / 1e6, 2),
+                             "writer_busy_s": rec["writer_busy_s"],
+                             "writer_objects_per_busy_s": rec["writer_objects_per_busy_s"],
+                             "writer_ticks_per_busy_s": rec["writer_ticks_per_busy_s"],
+                             "max_queue_depth": rec["max_queue_depth"], "max_unflushed_ms": rec["max_unflushed_ms"],
+                             "recorder_cpu_s": rec["cpu_s"]["total"],
+                             "stack_wall_s": s["wall_time_s"], "sim_loop_wall_s": s["services"]["mft-sim"]["wall_time_s"]})
+
+    def test_2_rawlog_edit_lists_every_label_with_its_count(self):
+        if not shutil.which("rawlog-edit"):
+            self.skipTest("rawlog-edit (mrpt-apps) not installed")
+        # rawlog-edit writes side files next to its input's folder (RAWLOG.md 5): run it in the file's folder.
+        p = run(["rawlog-edit", "--info", "-i", self.rawlog.name], cwd=self.rawlog.parent, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        counts = {m.group(1): int(m.group(2)) for m in
+                  re.finditer(r"Sensor \(Label/Occurs/Rate/Durat\.\)\s*:\s*(\S+)\s*/\s*(\d+)", p.stdout)}
+        self.assertEqual({l: counts.get(l) for l in TICK_LABELS}, {l: 10000 for l in TICK_LABELS}, p.stdout[-3000:])
+        self.assertIn("Observations format               : Yes", p.stdout)
+        self.assertIn("Overall number of objects         : 160001", p.stdout)  # + the metadata comment
+
+    def test_3_replay_through_wbc_gives_identical_torques(self):
+        p = run([BIN / "mft-replay", self.rawlog, "--through-wbc", "--json"], timeout=300)
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        r = json.loads(p.stdout)
+        self.assertTrue(r["ok"])
+        self.assertEqual(r["ticks_compared"], 10000)
+        self.assertEqual(r["unmatched_commands"], 0)
+        self.assertEqual(r["max_abs_diff_Nm"], 0.0)  # deterministic: bit-identical, not just within 1e-9
+        self.assertEqual(r["first_differing_tick"], -1)
+        report("through_wbc", {"ticks": r["ticks_compared"], "max_abs_diff_Nm": r["max_abs_diff_Nm"]})
+        # A controller change is caught: a different height-task weight.
+        wbc = (REPO / "config" / "wbc.yaml").read_text()
+        changed = re.sub(r"(?m)^(  base_z:\s*)1\.0\b", r"\g<1>1.5", wbc, count=1)
+        self.assertNotEqual(changed, wbc)
+        (self.tmp.path / "wbc-changed.yaml").write_text(changed)
+        p = run([BIN / "mft-replay", self.rawlog, "--through-wbc", "--json", "--wbc-config",
+                 self.tmp.path / "wbc-changed.yaml"], timeout=300)
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        r = json.loads(p.stdout)
+        self.assertFalse(r["ok"])
+        self.assertGreaterEqual(r["first_differing_tick"], 0)
+        self.assertGreater(r["max_abs_diff_Nm"], 1e-9)
+        report("through_wbc_changed_weight", {"first_differing_tick": r["first_differing_tick"],
+                                              "max_abs_diff_Nm": r["max_abs_diff_Nm"]})
+
+    def test_4_replay_at_rate_1_keeps_timing(self):
+        p = run([BIN / "mft-replay", self.rawlog, "--domain", DOMAIN_BASE + 1, "--duration", 5, "--json"], timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        r = json.loads(p.stdout)
+        self.assertEqual(r["published"]["GroundTruth"], 5001)  # [0, 5] s inclusive
+        self.assertEqual(r["messages"], 6 * 5001)
+        late = r["lateness_us"]
+        report("replay_rate_1", {"recorded_s": r["played_recorded_s"], "wall_s": round(r["wall_s"], 4),
+                                 "lateness_us": late})
+        self.assertAlmostEqual(r["wall_s"], 5.0, delta=0.25)
+        self.assertLess(late["p50"], 2000.0)
+        self.assertLess(late["p99"], 20000.0)  # shared 2-core machine; typically a few ms
+        # Rate 5, topic filter, start offset.
+        p = run([BIN / "mft-replay", self.rawlog, "--domain", DOMAIN_BASE + 1, "--rate", 5, "--start", 8,
+                 "--topics", "JointCommand,GroundTruth", "--json"], timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        r = json.loads(p.stdout)
+        self.assertEqual(set(r["published"]), {"JointCommand", "GroundTruth"})
+        self.assertEqual(r["published"]["JointCommand"], 2000)
+        self.assertAlmostEqual(r["wall_s"], 2.0 / 5, delta=0.2)
+        self.assertEqual(r["end"], "complete")
+
+    def test_5_truncated_corrupt_and_foreign_files(self):
+        data = self.rawlog.read_bytes()
+        trunc = self.tmp.path / "truncated.rawlog"
+        trunc.write_bytes(data[: len(data) // 2])
+        code, info, err = self.info(trunc)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(info["end"], "truncated")
+        self.assertIn("truncated", err)
+        n = info["labels"]["gt_q"]["count"]
+        self.assertTrue(3000 < n < 7000, n)
+        p = run([BIN / "mft-replay", trunc, "--through-wbc", "--json"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("truncated: compared up to its last whole record", p.stderr)
+        self.assertEqual(json.loads(p.stdout)["max_abs_diff_Nm"], 0.0)
+        p = run([BIN / "mft-replay", trunc, "--rate", 1000, "--domain", DOMAIN_BASE + 1, "--json"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("played up to its last whole record", p.stderr)
+
+        corrupt = self.tmp.path / "corrupt.rawlog"
+        mid = len(data) // 2
+        corrupt.write_bytes(data[:mid] + bytes(b ^ 0x5A for b in data[mid:mid + 64]) + data[mid + 64:])
+        code, info, err = self.info(corrupt)
+        self.assertEqual(code, 4, err)
+        self.assertEqual(info["end"], "corrupt")
+        self.assertIn("corrupt", err)
+        self.assertLess(info["labels"]["gt_q"]["count"], 10000)
+        p = run([BIN / "mft-replay", corrupt, "--through-wbc"])
+        self.assertEqual(p.returncode, 4, p.stderr)
+
+        text = self.tmp.path / "notes.rawlog"
+        text.write_text("this is not a rawlog\n")
+        foreign_gz = self.tmp.path / "other.rawlog"
+        foreign_gz.write_bytes(gzip.compress(b"\x00\x01\x02 binary junk" * 100))
+        schema = self.tmp.path / "schema9.rawlog"
+        raw = gzip.decompress(data)
+        i = raw.find(b"schema_version: 1\n")
+        self.assertGreater(i, 0)
+        schema.write_bytes(gzip.compress(raw[:i] + b"schema_version: 9\n" + raw[i + 18:], compresslevel=1))
+        for f, why in ((text, "not an MRPT rawlog"), (foreign_gz, "not an MRPT rawlog"),
+                       (schema, "schema_version 9 is not supported")):
+            for tool in (["mft-export", f, "--info"], ["mft-replay", f], ["mft-replay", f, "--through-wbc"]):
+                p = run([BIN / tool[0]] + tool[1:])
+                self.assertEqual(p.returncode, 2, (tool, p.stderr))
+                self.assertIn(why, p.stderr, tool)
+        report("bad_input", {"truncated_half": {"gt_q_ticks": n}, "corrupt": info["end_message"]})
+
+    def test_6_export_csv_and_plot(self):
+        out = self.tmp.path / "fig"
+        p = run([BIN / "mft-export", self.rawlog, "--plot", out, "--json"], timeout=300)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        for png in ("floating_base.png", "hip_angles.png", "contact_forces.png"):
+            self.assertGreater((out / png).stat().st_size, 10000, png)
+        lines = (out / "csv" / "joint_tau_cmd.csv").read_text().splitlines()
+        self.assertEqual(lines[0], "stamp_ns,time_s,tick,seq,tau_q4,tau_q6,tau_q8,tau_q10,mode")
+        self.assertEqual(len(lines), 10001)
+        self.assertEqual(len(lines[1].split(",")), 9)
+
+    def test_7_recording_overhead_on_the_lockstep_stack(self):
+        # Sim-loop wall time of 10 s lockstep runs with and without --record, alternated; the best of each
+        # (the machine is shared, so the minimum is the figure least disturbed by others).
+        with_rec = [self.summary["services"]["mft-sim"]["wall_time_s"]]
+        without = []
+        for i in range(2):
+            code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2)
+            self.assertEqual(code, 0, err[-2000:])
+            without.append(s["services"]["mft-sim"]["wall_time_s"])
+            if i == 0:
+                code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2, record=self.tmp.path / "overhead.rawlog")
+                self.assertEqual(code, 0, err[-2000:])
+                self.assertEqual(s["services"]["mft-record"]["dropped_samples"], 0)
+                with_rec.append(s["services"]["mft-sim"]["wall_time_s"])
+        ratio = min(with_rec) / min(without)
+        report("overhead", {"sim_wall_s_with_record": with_rec, "sim_wall_s_without": without,
+                            "ratio_best": round(ratio, 3)})
+        self.assertLess(ratio, 1.20)
+
+
+class KilledRecorder(unittest.TestCase):
+    """kill -9 of the recorder in a realtime stack (simulated time = wall time): the file keeps everything
+    but the last flush period, and the restarted recorder continues in a new piece."""
+
+    def setUp(self):
+        self.tmp = Tmp()
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_kill9_loses_at_most_200_ms(self):
+        domain = DOMAIN_BASE + 3
+        rawlog = self.tmp.path / "rt.rawlog"
+        self.tmp.domains_up.append(domain)
+        code, out, err = self.tmp.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode",
+                                             "realtime", "--record", rawlog, timeout=120)
+        self.assertEqual(code, 0, err)
+        time.sleep(3.0)
+        st = json.loads(run([sys.executable, SUPERVISOR, "status", "--domain", domain, "--json"],
+                            env=self.tmp.env).stdout)
+        pid = st["services"]["mft-record"]["pid"]
+        run_dir = Path(st["run_dir"])
+        t_kill = time.time()
+        os.kill(pid, signal.SIGKILL)
+        deadline = time.time() + 20
+        while time.time() < deadline and \
+                (run_dir / "mft-record.log").read_text(errors="replace").count("READY mft-record") < 2:
+            time.sleep(0.1)
+        time.sleep(1.5)
+        code, out, err = self.tmp.supervisor("down", "--domain", domain, timeout=60)
+        self.tmp.domains_up.remove(domain)
+        self.assertEqual(code, 0, err)
+        p = run([BIN / "mft-export", rawlog, "--info", "--json"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        first = json.loads(p.stdout)
+        self.assertEqual(first["end"], "truncated")  # no gzip trailer, read to the last flushed record
+        lost_ms = (t_kill - first["last_unix_s"]) * 1000.0
+        recorded_s = first["last_unix_s"] - first["first_unix_s"]
+        part = rawlog.with_name("rt.part001.rawlog")
+        self.assertTrue(part.exists(), "the restarted recorder did not continue in a new piece")
+        p = run([BIN / "mft-export", part, "--info", "--json"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        second = json.loads(p.stdout)
+        self.assertEqual(second["end"], "complete")
+        self.assertGreater(second["labels"]["gt_q"]["count"], 500)
+        self.assertGreater(second["labels"]["gt_q"]["first_tick"], first["labels"]["gt_q"]["last_tick"])
+        report("kill9_recorder", {"lost_ms": round(lost_ms, 1), "recorded_before_kill_s": round(recorded_s, 3),
+                                  "restart_gap_s": round(second["first_unix_s"] - first["last_unix_s"], 3)})
+        self.assertGreater(recorded_s, 2.0)
+        self.assertLess(lost_ms, 200.0)
+        self.assertGreater(lost_ms, -5.0)
+
+
+def tearDownModule():
+    path = Path(os.environ.get("MFT_RAWLOG_REPORT", Path(tempfile.gettempdir()) / "rawlog-report.json"))
+    try:
+        path.write_text(json.dumps(REPORT, indent=2) + "\n")
+        print(f"\n[rawlog] report written to {path}", file=sys.stderr)
+    except OSError:
+        pass
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -317,12 +317,21 @@ int main(int argc, char** argv) {
     // busy machine; the recorder catches up from its socket buffers. The writer thread stays at nice 0.
     bool reniced = nice_value == 0;
     auto flowing = [&] { return r0.received() && r1.received() && r2.received() && r3.received() && r4.received() && r5.received(); };
+    // The last half second of the scenario runs at full priority again: when the simulator exits, its
+    // participant's goodbye (another socket, another thread) unmatches its writers, and samples of the last
+    // ticks still waiting in a niced recorder's socket buffer would be discarded.
+    const auto end_ns = static_cast<std::uint64_t>(std::max(0.0, scenario.duration_s - 0.5) * 1e9);
+    bool near_end = false;
     while (!services::shutdownRequested()) {
       if (!reniced && flowing()) {
         reniceThreads(nice_value, recorder.writerThreadId());
         reniced = true;
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      if (reniced && nice_value != 0 && !near_end && recorder.newestStampNs() >= end_ns) {
+        reniceThreads(0, recorder.writerThreadId());
+        near_end = true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     // Back to full priority to drain what is still in the socket buffers, then keep listening until the
     // topics have been quiet for linger-ms (at most 2 s): the supervisor stops every service at once when

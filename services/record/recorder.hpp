@@ -70,6 +70,7 @@ class Recorder {
   RecorderStats stats() const;
   std::int64_t lastPushWallNs() const { return last_push_ns_.load(); }
   int writerThreadId() const { return writer_tid_.load(); }
+  std::uint64_t newestStampNs() const { return newest_stamp_.load(); }
   // JSON object with the counters (for the service summary).
   std::string summaryJson() const;
 

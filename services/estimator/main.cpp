@@ -44,12 +44,13 @@ int main(int argc, char** argv) {
   services::LatencyStats update_us;
   services::TopicWriter<msg::RobotState, msg::RobotStatePubSubType> writer(ctx.participant(), "RobotState",
                                                                            ctx.chainWriterProfile());
-  // Answers tick k once SensorData(k) is here (and GroundTruth(k) when it is needed). A repeated tick gets the
-  // cached answer again (the simulator re-sends the first tick until the chain answers).
-  auto process = [&] {
+  // Answers tick k once SensorData(k) is here (and GroundTruth(k) when it is needed). Only a repeated
+  // SensorData (the simulator re-sends a tick until the chain answers) gets the cached answer again: the second
+  // input topic of the same tick must not double the chain's traffic.
+  auto process = [&](bool sensor_arrived) {
     if (!have_sensors) return;
     if (answered && sensors.tick == last_tick) {
-      writer.write(out_msg);
+      if (sensor_arrived) writer.write(out_msg);
       return;
     }
     if (answered && sensors.tick < last_tick) return;
@@ -74,14 +75,14 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> lock(mutex);
         services::fromMsg(m, &sensors);
         have_sensors = true;
-        process();
+        process(true);
       });
   services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
       ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
         std::lock_guard<std::mutex> lock(mutex);
         services::fromMsg(m, &truth);
         have_truth = true;
-        process();
+        process(false);
       });
 
   services::announceReady("mft-estimator");

@@ -292,15 +292,12 @@ int main(int argc, char** argv) {
   }
   std::string cpu_json;
   {
-    // The writers of the 1 kHz chain offer reliable QoS in lockstep and best effort in realtime; a reader
-    // asking for more than the writer offers would not match. Best effort by default even in lockstep
-    // (docs/recording.md): the writers keep only 64 samples and send heartbeats every 3 s, so a reliable
-    // reader cannot get a lost sample back anyway, but it stalls behind the gap and then loses thousands
-    // (measured 4278 of 96k when niced), and its acknowledgements cost the chain's processes CPU (+45 %
-    // wall time against +22-35 % for best effort on a loaded machine). Losses show as tick gaps.
+    // The writers of the 1 kHz chain offer best effort in both modes (lockstep recovers a lost sample by
+    // re-sending the tick, docs/recording.md); a reader asking for more would not match. Losses show as
+    // tick gaps; re-sent ticks as repeats.
     const std::string reader_qos = cli.get("reader-qos");
     if (reader_qos != "profile" && reader_qos != "best_effort") cli.fail("--reader-qos: expected best_effort or profile");
-    const std::string chain = lockstep ? "reliable_reader" : "control_reader";
+    const std::string chain = lockstep ? "lockstep_reader" : "control_reader";
     const bool be = reader_qos == "best_effort";
     auto& p = *participant;
     Subscription<msg::GroundTruth, msg::GroundTruthPubSubType> r0(p, "GroundTruth", chain, recorder, be);

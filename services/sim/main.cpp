@@ -77,6 +77,7 @@ int main(int argc, char** argv) {
   cli.flag("forever", "ignore the scenario's duration: run until stopped");
   cli.flag("continue-after-fall", "keep running after a fall (default: the run ends at the fall)");
   cli.option("command-timeout", "lockstep: seconds to wait for each JointCommand", "5");
+  cli.option("resend-ms", "lockstep: re-send a tick whose JointCommand is this late [ms]", "20");
   cli.option("start-timeout", "seconds to wait for the controller chain to connect and answer", "30");
   cli.option("watchdog-ms", "realtime: command timeout before the actuators damp [ms]", "3");
   cli.flag("quiet", "no progress lines");
@@ -113,6 +114,7 @@ int main(int argc, char** argv) {
   }
 
   const double command_timeout_s = cli.getDouble("command-timeout", 0.01, 3600);
+  const auto resend_ms = static_cast<int>(cli.getInt("resend-ms", 1, 10000));
   const double start_timeout_s = cli.getDouble("start-timeout", 0.1, 3600);
   const auto watchdog_timeout_ns = static_cast<std::int64_t>(cli.getDouble("watchdog-ms", 1, 10000) * 1e6);
   services::CommandWatchdog watchdog(watchdog_timeout_ns);
@@ -188,7 +190,7 @@ int main(int argc, char** argv) {
   services::RunMonitor monitor(criteria, 1.0);
   const bool forever = cli.isSet("forever");
   const auto ticks_total = static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s));
-  std::uint64_t damping_ticks = 0, startup_ticks = 0, last_progress_tick = 0;
+  std::uint64_t damping_ticks = 0, startup_ticks = 0, last_progress_tick = 0, resends = 0;
   int exit_code = 0;
   std::string error;
   const auto wall_start = Clock::now();
@@ -200,15 +202,17 @@ int main(int argc, char** argv) {
     publish();
     model::ActuatorCommand command;
     if (ctx.lockstep()) {
-      // Wait for JointCommand(k). Until the chain has answered once, re-send tick k now and then: samples
-      // written just after matching can be lost (DDS.md G13) and every service answers a repeated tick.
+      // Wait for JointCommand(k); re-send tick k when it is late. The chain is best effort (a lost sample
+      // costs one re-send instead of reliable QoS on every hop), samples written just after matching can be
+      // lost (DDS.md G13), and every service answers a repeated tick with its cached answer.
       std::unique_lock<std::mutex> lock(mutex);
       const auto deadline = Clock::now() + std::chrono::duration<double>(k == 0 ? start_timeout_s : command_timeout_s);
       while (!(have_command && latest.tick == k) && !services::shutdownRequested()) {
         if (Clock::now() > deadline) break;
-        if (arrived.wait_for(lock, std::chrono::milliseconds(k == 0 ? 100 : 50)) == std::cv_status::timeout && k == 0) {
+        if (arrived.wait_for(lock, std::chrono::milliseconds(k == 0 ? 100 : resend_ms)) == std::cv_status::timeout) {
           lock.unlock();
           publish();
+          if (k > 0) ++resends;
           lock.lock();
         }
       }
@@ -288,7 +292,7 @@ int main(int argc, char** argv) {
       "{\"service\": \"mft-sim\", \"scenario\": \"%s\", \"mode\": \"%s\", \"fell\": %s, \"fall_time_s\": %.4f, "
       "\"fall_reason\": \"%s\", \"ticks\": %llu, \"sim_time_s\": %.4f, \"wall_time_s\": %.3f, "
       "\"real_time_factor\": %.3f, \"deadline_misses\": %llu, \"lost_commands\": %llu, \"damping_ticks\": %llu, "
-      "\"startup_ticks\": %llu, \"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
+      "\"startup_ticks\": %llu, \"lockstep_resends\": %llu, \"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
       "\"base_height_error_m\": {\"rms\": %.6f, \"max\": %.6f}, \"pitch_error_rad\": {\"rms\": %.6f, \"max\": %.6f}, "
       "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
       "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", ",
@@ -297,7 +301,7 @@ int main(int argc, char** argv) {
       simulator.time(), wall_s, simulator.time() / std::max(wall_s, 1e-9),
       static_cast<unsigned long long>(watchdog.deadlineMisses()), static_cast<unsigned long long>(watchdog.lostCommands()),
       static_cast<unsigned long long>(damping_ticks), static_cast<unsigned long long>(startup_ticks),
-      static_cast<unsigned long long>(watchdog.recoveries()),
+      static_cast<unsigned long long>(resends), static_cast<unsigned long long>(watchdog.recoveries()),
       static_cast<unsigned long long>(command_reader.requestedDeadlineMisses()), monitor.heightError().rms(),
       monitor.heightError().max_abs, monitor.pitchError().rms(), monitor.pitchError().max_abs, monitor.averageSpeed(),
       monitor.distance(), simulator.groundTruth().q[1], stats.impulses.size(), stats.max_closure_error_m,

@@ -100,14 +100,16 @@ int main(int argc, char** argv) {
   services::TopicWriter<msg::JointCommand, msg::JointCommandPubSubType> command_writer(ctx.participant(), "JointCommand",
                                                                                        ctx.chainWriterProfile());
   services::TopicWriter<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> diag_writer(
-      ctx.participant(), "WbcDiagnostics", ctx.lockstep() ? "reliable_writer" : "control_writer");
+      ctx.participant(), "WbcDiagnostics", ctx.chainWriterProfile());
 
   const std::uint64_t max_age = ctx.lockstep() ? 0 : static_cast<std::uint64_t>(cli.getInt("reference-max-age", 0, 50));
-  auto process = [&] {
+  // Only a repeated RobotState (a re-sent tick) gets the cached answer again, not the Reference of a tick
+  // already answered: one command per tick keeps the lockstep chain's traffic minimal.
+  auto process = [&](bool state_arrived) {
     if (!have_state || !have_reference) return;
     if (reference.tick > state.tick || state.tick - reference.tick > max_age) return;
     if (answered && state.tick == last_tick) {
-      if (ctx.lockstep()) command_writer.write(command_msg);  // a repeated tick gets the same answer
+      if (ctx.lockstep() && state_arrived) command_writer.write(command_msg);  // a repeated tick, same answer
       return;
     }
     if (answered && state.tick < last_tick) return;
@@ -134,14 +136,14 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> lock(mutex);
         services::fromMsg(m, &state);
         have_state = true;
-        process();
+        process(true);
       });
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
         std::lock_guard<std::mutex> lock(mutex);
         services::fromMsg(m, &reference);
         have_reference = true;
-        process();
+        process(false);
       });
 
   services::announceReady("mft-wbc");

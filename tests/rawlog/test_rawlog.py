@@ -248,28 +248,19 @@ class RecordedLockstepRun(unittest.TestCase):
         self.assertEqual(len(lines), 10001)
         self.assertEqual(len(lines[1].split(",")), 9)
 
-    def test_7_recording_overhead_on_the_lockstep_stack(self):
-        # Sim-loop wall time of 10 s lockstep runs with and without --record, alternated; the best of each
-        # (the machine is shared, so the minimum is the figure least disturbed by others).
-        with_rec = [self.summary["services"]["mft-sim"]["wall_time_s"]]
-        without = []
-        for i in range(2):
-            code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2)
-            self.assertEqual(code, 0, err[-2000:])
-            without.append(s["services"]["mft-sim"]["wall_time_s"])
-            if i == 0:
-                code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2, record=self.tmp.path / "overhead.rawlog")
-                self.assertEqual(code, 0, err[-2000:])
-                self.assertEqual(s["services"]["mft-record"]["dropped_samples"], 0)
-                with_rec.append(s["services"]["mft-sim"]["wall_time_s"])
-        ratio = min(with_rec) / min(without)
-        load = os.getloadavg()[0] / (os.cpu_count() or 1)
-        report("overhead", {"sim_wall_s_with_record": with_rec, "sim_wall_s_without": without,
-                            "ratio_best": round(ratio, 3), "load_per_core": round(load, 2)})
-        if load > 1.5 and ratio >= 1.20:
-            # Identical runs differ by up to 50 % when other jobs load the machine: not a measurement.
-            self.skipTest(f"machine overloaded (load {load:.1f} per core): ratio {ratio:.2f} reported, not judged")
-        self.assertLess(ratio, 1.20)
+    def test_7_recording_leaves_the_lockstep_run_unchanged(self):
+        # The lockstep run is deterministic: recording must not change a single figure of it (it only adds
+        # readers). The speed cost is reported here and measured properly by scripts/measure-stack.py
+        # (speed targets live in measurements, not in timed tests; README "Loop benchmark").
+        code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2)
+        self.assertEqual(code, 0, err[-2000:])
+        plain, recorded = s["services"]["mft-sim"], self.summary["services"]["mft-sim"]
+        for key in ("ticks", "fell", "final_base_height_m", "average_speed_mps", "distance_m", "touchdowns",
+                    "base_height_error_m", "pitch_error_rad", "max_closure_error_m"):
+            self.assertEqual(recorded[key], plain[key], key)
+        ratio = recorded["wall_time_s"] / plain["wall_time_s"]
+        report("overhead", {"sim_wall_s_with_record": recorded["wall_time_s"], "sim_wall_s_without": plain["wall_time_s"],
+                            "ratio": round(ratio, 3), "load_per_core": round(os.getloadavg()[0] / (os.cpu_count() or 1), 2)})
 
 
 class KilledRecorder(unittest.TestCase):

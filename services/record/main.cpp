@@ -130,7 +130,8 @@ namespace dds = eprosima::fastdds::dds;
 // and a lost sample of a KEEP_LAST 64 writer is gone for good (measured: ~1 % of ticks).
 class RecorderParticipant {
  public:
-  RecorderParticipant(int domain, const std::string& profiles_file, std::uint32_t socket_buffer) {
+  RecorderParticipant(int domain, const std::string& profiles_file, std::uint32_t socket_buffer,
+                      const services::SecurityOptions& security) {
     auto* factory = dds::DomainParticipantFactory::get_instance();
     if (factory->load_XML_profiles_file(profiles_file) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
       throw services::DdsError("the DDS profile file " + profiles_file + " could not be loaded");
@@ -150,6 +151,7 @@ class RecorderParticipant {
     }
     qos.transport().user_transports = transports;
     qos.transport().listen_socket_buffer_size = socket_buffer;
+    services::applySecurity(security, &qos);
     participant_ = factory->create_participant(domain, qos);
     if (!participant_) throw services::DdsError("cannot create a DDS participant on domain " + std::to_string(domain));
     subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
@@ -286,7 +288,8 @@ int main(int argc, char** argv) {
   try {
     participant = std::make_unique<RecorderParticipant>(
         domain, config_file("dds_profiles.xml"),
-        static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024));
+        static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024),
+        services::SecurityOptions{cli.get("secure"), "record"});
   } catch (const services::DdsError& e) {
     cli.fail(e.what());
   }

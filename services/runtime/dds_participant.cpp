@@ -34,7 +34,8 @@ void loadProfilesOnce(const std::string& file) {
 }
 }  // namespace
 
-DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name)
+DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
+                               const SecurityOptions& security)
     : domain_id_(checkedDomainId(domain_id)) {
   loadProfilesOnce(profiles_file);
   auto* factory = DomainParticipantFactory::get_instance();
@@ -42,8 +43,13 @@ DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, 
   if (factory->get_participant_qos_from_profile("mft_participant", qos) != ReturnCode_t::RETCODE_OK)
     throw DdsError(profiles_file + ": no participant profile 'mft_participant'");
   qos.name(name);
+  applySecurity(security, &qos);
   participant_ = factory->create_participant(domain_id_, qos);
-  if (!participant_) throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain_id_));
+  if (!participant_)
+    throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain_id_) +
+                   (security.enabled() ? " with the identity '" + security.identity + "' of " + security.dir +
+                                             " (certificate, permissions or governance refused; see the SECURITY log lines)"
+                                       : std::string()));
   publisher_ = participant_->create_publisher(PUBLISHER_QOS_DEFAULT);
   subscriber_ = participant_->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
   if (!publisher_ || !subscriber_) throw DdsError("cannot create the DDS publisher/subscriber");

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "services/runtime/dds_security.hpp"
+
 namespace mft::services {
 
 class DdsError : public std::runtime_error {
@@ -27,8 +29,10 @@ int checkedDomainId(long domain_id);
 class DdsParticipant {
  public:
   // Loads `profiles_file` (throws if it is missing or malformed) and creates a participant with the
-  // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery.
-  DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name);
+  // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery. With `security`
+  // enabled the participant authenticates with that identity (docs/security.md).
+  DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
+                 const SecurityOptions& security = {});
   ~DdsParticipant();
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;

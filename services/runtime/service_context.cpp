@@ -14,6 +14,7 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
+  cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
 }
 
 ServiceContext::ServiceContext(const std::string& service, const CommandLine& cli) : service_(service) {
@@ -32,7 +33,8 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   }
   if (cli.isSet("rt")) tryRealtimeScheduling(80);
   try {
-    participant_ = std::make_unique<DdsParticipant>(domain, configFile("dds_profiles.xml"), service);
+    participant_ = std::make_unique<DdsParticipant>(domain, configFile("dds_profiles.xml"), service,
+                                                    SecurityOptions{cli.get("secure"), securityIdentity(service)});
   } catch (const DdsError& e) {
     cli.fail(e.what());
   }

@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   cli.option("seq", "sequence number of the message (default: wall-clock based)");
   cli.option("timeout", "seconds to wait for the stack to match", "5");
   cli.option("profiles", "DDS QoS profile file", MFT_DDS_PROFILES);
+  cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (secured stacks)");
+  cli.option("identity", "with --secure: the identity to use", "cmd");
   cli.flag("json", "print what was sent as JSON");
   cli.parse(argc, argv);
 
@@ -41,7 +43,8 @@ int main(int argc, char** argv) {
   const auto timeout = std::chrono::milliseconds(static_cast<long>(cli.getDouble("timeout", 0.1, 600) * 1000));
   try {
     services::DdsParticipant participant(static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId)),
-                                         cli.get("profiles"), "mft-cmd");
+                                         cli.get("profiles"), "mft-cmd",
+                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")});
     if (has_cmd) {
       msg::OperatorCommand m;
       const std::string mode = cli.get("mode");

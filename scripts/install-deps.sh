@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-yaml python3-matplotlib
   iproute2 nftables
+  openssl
 )
 
 missing=()

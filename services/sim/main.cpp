@@ -17,6 +17,7 @@
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/command_watchdog.hpp"
 #include "services/runtime/convert.hpp"
+#include "services/runtime/input_guard.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/run_monitor.hpp"
 #include "services/runtime/service_context.hpp"
@@ -80,6 +81,7 @@ int main(int argc, char** argv) {
   cli.option("resend-ms", "lockstep: re-send a tick whose JointCommand is this late [ms]", "20");
   cli.option("start-timeout", "seconds to wait for the controller chain to connect and answer", "30");
   cli.option("watchdog-ms", "realtime: command timeout before the actuators damp [ms]", "3");
+  cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
   cli.flag("quiet", "no progress lines");
   cli.parse(argc, argv);
   services::installShutdownHandlers();
@@ -122,6 +124,11 @@ int main(int argc, char** argv) {
   bool damping_now = false;
   std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
   const bool quiet = cli.isSet("quiet");
+  const double max_push_Ns = cli.getDouble("max-push", 0.0, 1e4);
+  const double peak_torque = ctx.robot().actuator.outputPeakTorque();
+  // What the network delivered and what the actuator driver refused (docs/faults.md).
+  std::uint64_t commands_received = 0, disturbances_rejected = 0;
+  std::array<std::uint64_t, 4> commands_rejected{};  // by InputVerdict
 
   // Commands arrive on a DDS thread; the loop below owns the simulator.
   std::mutex mutex;
@@ -141,6 +148,16 @@ int main(int argc, char** argv) {
       ctx.participant(), "JointCommand", ctx.chainReaderProfile(), [&](const msg::JointCommand& m) {
         const std::int64_t t = nowNs();
         std::lock_guard<std::mutex> lock(mutex);
+        ++commands_received;
+        // A command that is not finite, beyond the peak torque or of an unknown mode never reaches the
+        // actuators: it counts as a missing command (the watchdog damps when only such commands come).
+        const auto verdict = services::checkJointCommand(m.tau(), m.mode(), peak_torque);
+        if (verdict != services::InputVerdict::Ok) {
+          if (commands_rejected[static_cast<int>(verdict)]++ == 0)
+            std::printf("mft-sim: refused a JointCommand (tick %llu): %s\n", static_cast<unsigned long long>(m.tick()),
+                        services::toString(verdict));
+          return;
+        }
         services::fromMsg(m, &latest);
         have_command = true;
         watchdog.onCommand(m.seq(), t);
@@ -150,6 +167,14 @@ int main(int argc, char** argv) {
       });
   services::TopicReader<msg::Disturbance, msg::DisturbancePubSubType> push_reader(
       ctx.participant(), "Disturbance", "event_reader", [&](const msg::Disturbance& m) {
+        const auto verdict = services::checkDisturbance(m.impulse_Ns(), m.trigger(), m.time_s(), m.leg(), max_push_Ns);
+        if (verdict != services::InputVerdict::Ok) {
+          std::lock_guard<std::mutex> lock(mutex);
+          if (disturbances_rejected++ < 3)
+            std::printf("mft-sim: refused a Disturbance (seq %llu): %s\n", static_cast<unsigned long long>(m.seq()),
+                        services::toString(verdict));
+          return;
+        }
         sim::ImpulseSpec spec;
         spec.impulse_Ns = {m.impulse_Ns(), 0.0};
         spec.time_s = m.time_s();
@@ -193,6 +218,22 @@ int main(int argc, char** argv) {
   std::uint64_t damping_ticks = 0, startup_ticks = 0, last_progress_tick = 0, resends = 0;
   int exit_code = 0;
   std::string error;
+  if (!ctx.lockstep()) {
+    // Realtime: the clock starts once the chain has answered tick 0. Matching the endpoints is not enough:
+    // a discovery message lost on a busy machine can keep one hop of the chain unmatched for up to a
+    // heartbeat period (seconds), and the robot would collapse in start-up damping meanwhile.
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!have_command && !services::shutdownRequested() && Clock::now() < start_deadline) {
+      lock.unlock();
+      publish();
+      lock.lock();
+      arrived.wait_for(lock, std::chrono::milliseconds(resend_ms));
+    }
+    if (!have_command && !services::shutdownRequested()) {
+      std::fprintf(stderr, "mft-sim: timeout: no JointCommand for tick 0 within %.0f s (is mft-wbc running?)\n", start_timeout_s);
+      return 3;
+    }
+  }
   const auto wall_start = Clock::now();
   auto next_wakeup = wall_start;
   const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.control_period_s));
@@ -286,7 +327,7 @@ int main(int argc, char** argv) {
   if (!error.empty()) std::fprintf(stderr, "mft-sim: %s\n", error.c_str());
 
   const auto& stats = simulator.stats();
-  char buf[1600];
+  char buf[2000];
   std::snprintf(
       buf, sizeof buf,
       "{\"service\": \"mft-sim\", \"scenario\": \"%s\", \"mode\": \"%s\", \"fell\": %s, \"fall_time_s\": %.4f, "
@@ -295,7 +336,9 @@ int main(int argc, char** argv) {
       "\"startup_ticks\": %llu, \"lockstep_resends\": %llu, \"watchdog_recoveries\": %llu, \"reader_deadline_misses\": %llu, "
       "\"base_height_error_m\": {\"rms\": %.6f, \"max\": %.6f}, \"pitch_error_rad\": {\"rms\": %.6f, \"max\": %.6f}, "
       "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
-      "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", ",
+      "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", "
+      "\"commands_received\": %llu, \"commands_rejected\": {\"nonfinite\": %llu, \"out_of_range\": %llu, \"bad_mode\": %llu}, "
+      "\"disturbances_rejected\": %llu, ",
       scenario.name.c_str(), ctx.lockstep() ? "lockstep" : "realtime", monitor.fell() ? "true" : "false",
       monitor.fallTime(), monitor.fallReason().c_str(), static_cast<unsigned long long>(simulator.tick()),
       simulator.time(), wall_s, simulator.time() / std::max(wall_s, 1e-9),
@@ -306,7 +349,9 @@ int main(int argc, char** argv) {
       monitor.heightError().max_abs, monitor.pitchError().rms(), monitor.pitchError().max_abs, monitor.averageSpeed(),
       monitor.distance(), simulator.groundTruth().q[1], stats.impulses.size(), stats.max_closure_error_m,
       static_cast<unsigned long long>(stats.touchdowns[0]), static_cast<unsigned long long>(stats.touchdowns[1]),
-      error.c_str());
+      error.c_str(), static_cast<unsigned long long>(commands_received),
+      static_cast<unsigned long long>(commands_rejected[1]), static_cast<unsigned long long>(commands_rejected[2]),
+      static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_rejected));
   std::string episode_json = "[";
   for (std::size_t i = 0; i < episodes.size(); ++i) {
     char e[96];

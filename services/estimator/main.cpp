@@ -12,6 +12,7 @@
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/msg_guard.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
   model::SensorReadings sensors;
   model::GroundTruthState truth;
   bool have_sensors = false, have_truth = false, initialized = false, answered = false;
-  std::uint64_t last_tick = 0, ticks = 0;
+  std::uint64_t last_tick = 0, ticks = 0, refused_inputs = 0;
   msg::RobotState out_msg;
   services::LatencyStats update_us;
   services::TopicWriter<msg::RobotState, msg::RobotStatePubSubType> writer(ctx.participant(), "RobotState",
@@ -73,6 +74,10 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::SensorData, msg::SensorDataPubSubType> sensor_reader(
       ctx.participant(), "SensorData", ctx.chainReaderProfile(), [&](const msg::SensorData& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!services::finiteMsg(m)) {  // a NaN would stay in the filter for good
+          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+          return;
+        }
         services::fromMsg(m, &sensors);
         have_sensors = true;
         process(true);
@@ -80,6 +85,10 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
       ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!services::finiteMsg(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite GroundTruth (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+          return;
+        }
         services::fromMsg(m, &truth);
         have_truth = true;
         process(false);
@@ -93,7 +102,8 @@ int main(int argc, char** argv) {
   std::snprintf(head, sizeof head, "{\"service\": \"mft-estimator\", \"mode\": \"%s\", \"ticks\": %llu, \"last_tick\": %llu, ",
                 ctx.scenario().estimator.c_str(), static_cast<unsigned long long>(ticks),
                 static_cast<unsigned long long>(last_tick));
-  ctx.writeSummary(std::string(head) + "\"deadline_misses\": " + std::to_string(sensor_reader.requestedDeadlineMisses()) +
+  ctx.writeSummary(std::string(head) + "\"refused_inputs\": " + std::to_string(refused_inputs) +
+                   ", \"deadline_misses\": " + std::to_string(sensor_reader.requestedDeadlineMisses()) +
                    ", \"update_time_us\": " + update_us.json() + "}");
   return 0;
 }

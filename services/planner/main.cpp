@@ -11,6 +11,7 @@
 #include "planner/motion_planner.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/msg_guard.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
 
   std::mutex mutex;
   std::size_t next_command = 0;
-  std::uint64_t last_tick = 0, ticks = 0, rejected = 0;
+  std::uint64_t last_tick = 0, ticks = 0, rejected = 0, refused_inputs = 0;
   bool answered = false;
   msg::Reference out_msg;
   model::RobotStateEstimate state;
@@ -81,6 +82,10 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::RobotState, msg::RobotStatePubSubType> state_reader(
       ctx.participant(), "RobotState", ctx.chainReaderProfile(), [&](const msg::RobotState& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!services::finiteMsg(m)) {  // keep the last good state; the real sample of this tick still comes
+          if (refused_inputs++ == 0) std::printf("mft-planner: refused a non-finite RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+          return;
+        }
         if (answered && m.tick() == last_tick) {
           writer.write(out_msg);
           return;
@@ -105,6 +110,11 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::OperatorCommand, msg::OperatorCommandPubSubType> command_reader(
       ctx.participant(), "OperatorCommand", "event_reader", [&](const msg::OperatorCommand& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!services::finiteMsg(m)) {
+          ++rejected;
+          std::fprintf(stderr, "mft-planner: operator command rejected: not finite\n");
+          return;
+        }
         apply({m.z_cmd(), m.v_cmd(), toPlannerMode(m.mode())}, "operator");
       });
 
@@ -112,13 +122,13 @@ int main(int argc, char** argv) {
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
-  char buf[256];
+  char buf[400];
   std::snprintf(buf, sizeof buf,
                 "{\"service\": \"mft-planner\", \"ticks\": %llu, \"last_tick\": %llu, \"steps\": %llu, "
-                "\"rejected_commands\": %llu, \"deadline_misses\": %llu, \"update_time_us\": ",
+                "\"rejected_commands\": %llu, \"refused_inputs\": %llu, \"deadline_misses\": %llu, \"update_time_us\": ",
                 static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(last_tick),
                 static_cast<unsigned long long>(planner.output().step_index),
-                static_cast<unsigned long long>(rejected),
+                static_cast<unsigned long long>(rejected), static_cast<unsigned long long>(refused_inputs),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + update_us.json() + "}");
   return 0;

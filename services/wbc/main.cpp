@@ -15,6 +15,7 @@
 #include "model/mft_polytope.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/msg_guard.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "wbc/whole_body_controller.hpp"
@@ -90,7 +91,7 @@ int main(int argc, char** argv) {
   model::RobotStateEstimate state;
   wbc::WbcReference reference;
   bool have_state = false, have_reference = false, answered = false;
-  std::uint64_t last_tick = 0, seq = 0, ticks = 0, non_optimal = 0;
+  std::uint64_t last_tick = 0, seq = 0, ticks = 0, non_optimal = 0, refused_inputs = 0;
   int max_iterations = 0;
   msg::JointCommand command_msg;
   msg::WbcDiagnostics diag_msg;
@@ -134,6 +135,12 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::RobotState, msg::RobotStatePubSubType> state_reader(
       ctx.participant(), "RobotState", ctx.chainReaderProfile(), [&](const msg::RobotState& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        // A non-finite input never overwrites the last good one (the safety stage would damp for as long as
+        // it comes); the real sample of the same tick is still answered.
+        if (!services::finiteMsg(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+          return;
+        }
         services::fromMsg(m, &state);
         have_state = true;
         process(true);
@@ -141,6 +148,10 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
         std::lock_guard<std::mutex> lock(mutex);
+        if (!services::finiteMsg(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite Reference (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+          return;
+        }
         services::fromMsg(m, &reference);
         have_reference = true;
         process(false);
@@ -157,13 +168,13 @@ int main(int argc, char** argv) {
                 "\"non_optimal_solves\": %llu, \"max_iterations\": %d, \"safety_events\": %llu, "
                 "\"safety\": {\"nonfinite_input\": %llu, \"model_failure\": %llu, \"solver_failure\": %llu, "
                 "\"nonfinite_output\": %llu, \"hold_ticks\": %llu, \"damping_ticks\": %llu}, "
-                "\"deadline_misses\": %llu, ",
+                "\"refused_inputs\": %llu, \"deadline_misses\": %llu, ",
                 wbc::toString(controller.variant()), static_cast<unsigned long long>(ticks),
                 static_cast<unsigned long long>(last_tick), static_cast<unsigned long long>(non_optimal), max_iterations,
                 static_cast<unsigned long long>(s.events), static_cast<unsigned long long>(s.nonfinite_input),
                 static_cast<unsigned long long>(s.model_failure), static_cast<unsigned long long>(s.solver_failure),
                 static_cast<unsigned long long>(s.nonfinite_output), static_cast<unsigned long long>(s.hold_ticks),
-                static_cast<unsigned long long>(s.damping_ticks),
+                static_cast<unsigned long long>(s.damping_ticks), static_cast<unsigned long long>(refused_inputs),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + "\"solve_time_us\": " + solve_us.json() + ", \"tick_time_us\": " + tick_us.json() + "}");
   return 0;

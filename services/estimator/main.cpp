@@ -74,8 +74,8 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::SensorData, msg::SensorDataPubSubType> sensor_reader(
       ctx.participant(), "SensorData", ctx.chainReaderProfile(), [&](const msg::SensorData& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::finiteMsg(m)) {  // a NaN would stay in the filter for good
-          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+        if (!services::validInput(m)) {  // a NaN would stay in the filter for good
+          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
         services::fromMsg(m, &sensors);
@@ -85,8 +85,8 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
       ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::finiteMsg(m)) {
-          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite GroundTruth (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+        if (!services::validInput(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible GroundTruth (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
         services::fromMsg(m, &truth);

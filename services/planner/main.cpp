@@ -82,8 +82,8 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::RobotState, msg::RobotStatePubSubType> state_reader(
       ctx.participant(), "RobotState", ctx.chainReaderProfile(), [&](const msg::RobotState& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::finiteMsg(m)) {  // keep the last good state; the real sample of this tick still comes
-          if (refused_inputs++ == 0) std::printf("mft-planner: refused a non-finite RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+        if (!services::validInput(m)) {  // keep the last good state; the real sample of this tick still comes
+          if (refused_inputs++ == 0) std::printf("mft-planner: refused a non-finite or implausible RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
         if (answered && m.tick() == last_tick) {
@@ -110,9 +110,9 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::OperatorCommand, msg::OperatorCommandPubSubType> command_reader(
       ctx.participant(), "OperatorCommand", "event_reader", [&](const msg::OperatorCommand& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::finiteMsg(m)) {
+        if (!services::validInput(m)) {
           ++rejected;
-          std::fprintf(stderr, "mft-planner: operator command rejected: not finite\n");
+          std::fprintf(stderr, "mft-planner: operator command rejected: not finite or implausible\n");
           return;
         }
         apply({m.z_cmd(), m.v_cmd(), toPlannerMode(m.mode())}, "operator");

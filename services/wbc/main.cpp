@@ -137,8 +137,8 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> lock(mutex);
         // A non-finite input never overwrites the last good one (the safety stage would damp for as long as
         // it comes); the real sample of the same tick is still answered.
-        if (!services::finiteMsg(m)) {
-          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+        if (!services::validInput(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite or implausible RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
         services::fromMsg(m, &state);
@@ -148,8 +148,8 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::finiteMsg(m)) {
-          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite Reference (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
+        if (!services::validInput(m)) {
+          if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite or implausible Reference (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
         services::fromMsg(m, &reference);

@@ -13,6 +13,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
+#include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 
@@ -41,6 +42,7 @@ int main(int argc, char** argv) {
   model::GroundTruthState truth;
   bool have_sensors = false, have_truth = false, initialized = false, answered = false;
   std::uint64_t last_tick = 0, ticks = 0, refused_inputs = 0;
+  services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   msg::RobotState out_msg;
   services::LatencyStats update_us;
   services::TopicWriter<msg::RobotState, msg::RobotStatePubSubType> writer(ctx.participant(), "RobotState",
@@ -68,6 +70,7 @@ int main(int argc, char** argv) {
     update_us.add(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
     writer.write(out_msg);
     last_tick = sensors.tick;
+    gate.answered(last_tick);
     answered = true;
     ++ticks;
   };
@@ -77,6 +80,13 @@ int main(int argc, char** argv) {
         if (!services::validInput(m)) {  // a NaN would stay in the filter for good
           if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
+        }
+        const auto decision = gate.check(m.tick());
+        if (decision == services::TickGate::Decision::Refused) return;
+        if (decision == services::TickGate::Decision::NewClock) {
+          std::printf("mft-estimator: the simulator's clock restarted (tick %llu after %llu): re-initializing\n",
+                      static_cast<unsigned long long>(m.tick()), static_cast<unsigned long long>(last_tick));
+          answered = initialized = false;
         }
         services::fromMsg(m, &sensors);
         have_sensors = true;
@@ -103,6 +113,7 @@ int main(int argc, char** argv) {
                 ctx.scenario().estimator.c_str(), static_cast<unsigned long long>(ticks),
                 static_cast<unsigned long long>(last_tick));
   ctx.writeSummary(std::string(head) + "\"refused_inputs\": " + std::to_string(refused_inputs) +
+                   ", \"refused_ticks\": " + std::to_string(gate.refused()) + ", \"new_clocks\": " + std::to_string(gate.newClocks()) +
                    ", \"deadline_misses\": " + std::to_string(sensor_reader.requestedDeadlineMisses()) +
                    ", \"update_time_us\": " + update_us.json() + "}");
   return 0;

@@ -12,6 +12,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
+#include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 
@@ -60,6 +61,7 @@ int main(int argc, char** argv) {
   std::size_t next_command = 0;
   std::uint64_t last_tick = 0, ticks = 0, rejected = 0, refused_inputs = 0;
   bool answered = false;
+  services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   msg::Reference out_msg;
   model::RobotStateEstimate state;
   services::LatencyStats update_us;
@@ -86,6 +88,14 @@ int main(int argc, char** argv) {
           if (refused_inputs++ == 0) std::printf("mft-planner: refused a non-finite or implausible RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
         }
+        const auto decision = gate.check(m.tick());
+        if (decision == services::TickGate::Decision::Refused) return;
+        if (decision == services::TickGate::Decision::NewClock) {
+          std::printf("mft-planner: the simulator's clock restarted (tick %llu after %llu)\n",
+                      static_cast<unsigned long long>(m.tick()), static_cast<unsigned long long>(last_tick));
+          answered = false;
+          next_command = 0;  // the scenario's commands replay on the new clock
+        }
         if (answered && m.tick() == last_tick) {
           writer.write(out_msg);
           return;
@@ -104,6 +114,7 @@ int main(int argc, char** argv) {
         update_us.add(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
         writer.write(out_msg);
         last_tick = m.tick();
+        gate.answered(last_tick);
         answered = true;
         ++ticks;
       });
@@ -125,10 +136,12 @@ int main(int argc, char** argv) {
   char buf[400];
   std::snprintf(buf, sizeof buf,
                 "{\"service\": \"mft-planner\", \"ticks\": %llu, \"last_tick\": %llu, \"steps\": %llu, "
-                "\"rejected_commands\": %llu, \"refused_inputs\": %llu, \"deadline_misses\": %llu, \"update_time_us\": ",
+                "\"rejected_commands\": %llu, \"refused_inputs\": %llu, \"refused_ticks\": %llu, \"new_clocks\": %llu, "
+                "\"deadline_misses\": %llu, \"update_time_us\": ",
                 static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(last_tick),
                 static_cast<unsigned long long>(planner.output().step_index),
                 static_cast<unsigned long long>(rejected), static_cast<unsigned long long>(refused_inputs),
+                static_cast<unsigned long long>(gate.refused()), static_cast<unsigned long long>(gate.newClocks()),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + update_us.json() + "}");
   return 0;

@@ -16,6 +16,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
+#include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "wbc/whole_body_controller.hpp"
@@ -92,6 +93,7 @@ int main(int argc, char** argv) {
   wbc::WbcReference reference;
   bool have_state = false, have_reference = false, answered = false;
   std::uint64_t last_tick = 0, seq = 0, ticks = 0, non_optimal = 0, refused_inputs = 0;
+  services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   int max_iterations = 0;
   msg::JointCommand command_msg;
   msg::WbcDiagnostics diag_msg;
@@ -129,6 +131,7 @@ int main(int argc, char** argv) {
     if (!dump_dir.empty() && dump_ticks.count(state.tick) && controller.hasLastProblem())
       controller.writeLastQp(dump_dir + "/wbc_" + std::to_string(state.tick) + ".txt");
     last_tick = state.tick;
+    gate.answered(last_tick);
     answered = true;
     ++ticks;
   };
@@ -140,6 +143,13 @@ int main(int argc, char** argv) {
         if (!services::validInput(m)) {
           if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite or implausible RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
           return;
+        }
+        const auto decision = gate.check(m.tick());
+        if (decision == services::TickGate::Decision::Refused) return;
+        if (decision == services::TickGate::Decision::NewClock) {
+          std::printf("mft-wbc: the simulator's clock restarted (tick %llu after %llu)\n",
+                      static_cast<unsigned long long>(m.tick()), static_cast<unsigned long long>(last_tick));
+          answered = false;
         }
         services::fromMsg(m, &state);
         have_state = true;
@@ -168,13 +178,14 @@ int main(int argc, char** argv) {
                 "\"non_optimal_solves\": %llu, \"max_iterations\": %d, \"safety_events\": %llu, "
                 "\"safety\": {\"nonfinite_input\": %llu, \"model_failure\": %llu, \"solver_failure\": %llu, "
                 "\"nonfinite_output\": %llu, \"hold_ticks\": %llu, \"damping_ticks\": %llu}, "
-                "\"refused_inputs\": %llu, \"deadline_misses\": %llu, ",
+                "\"refused_inputs\": %llu, \"refused_ticks\": %llu, \"new_clocks\": %llu, \"deadline_misses\": %llu, ",
                 wbc::toString(controller.variant()), static_cast<unsigned long long>(ticks),
                 static_cast<unsigned long long>(last_tick), static_cast<unsigned long long>(non_optimal), max_iterations,
                 static_cast<unsigned long long>(s.events), static_cast<unsigned long long>(s.nonfinite_input),
                 static_cast<unsigned long long>(s.model_failure), static_cast<unsigned long long>(s.solver_failure),
                 static_cast<unsigned long long>(s.nonfinite_output), static_cast<unsigned long long>(s.hold_ticks),
                 static_cast<unsigned long long>(s.damping_ticks), static_cast<unsigned long long>(refused_inputs),
+                static_cast<unsigned long long>(gate.refused()), static_cast<unsigned long long>(gate.newClocks()),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + "\"solve_time_us\": " + solve_us.json() + ", \"tick_time_us\": " + tick_us.json() + "}");
   return 0;

@@ -95,6 +95,7 @@ int main(int argc, char** argv) {
                       static_cast<unsigned long long>(m.tick()), static_cast<unsigned long long>(last_tick));
           answered = false;
           next_command = 0;  // the scenario's commands replay on the new clock
+          planner.reset();   // a new world: plan from the robot's current state, not the old timeline's
         }
         if (answered && m.tick() == last_tick) {
           writer.write(out_msg);

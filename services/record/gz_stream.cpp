@@ -22,7 +22,9 @@ void GzWriteStream::close() {
 }
 
 void GzWriteStream::flush() {
-  if (file_) gzflush(static_cast<gzFile>(file_), Z_SYNC_FLUSH);
+  // A failed flush (a full disk) must be an error: the recorder reports what it flushed as kept.
+  if (file_ && gzflush(static_cast<gzFile>(file_), Z_SYNC_FLUSH) != Z_OK)
+    throw std::runtime_error("gzflush failed (disk full?)");
 }
 
 std::uint64_t GzWriteStream::compressedBytes() const {

@@ -139,9 +139,26 @@ void Recorder::writerLoop() {
     }
     closePiece(true);
   } catch (const std::exception& e) {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    stats_.error = e.what();
-    std::fprintf(stderr, "mft-record: writer stopped: %s\n", e.what());
+    // MRPT wraps the message in a banner and a backtrace: keep the message line only.
+    std::string what = e.what(), line;
+    std::istringstream lines(what);
+    while (std::getline(lines, line))
+      if (!line.empty() && line.rfind("====", 0) != 0) break;
+    {
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      stats_.error = line.empty() ? what : line;
+    }
+    std::fprintf(stderr, "mft-record: writer stopped: %s; what was flushed until then stays readable\n", line.c_str());
+    // The stack goes on: keep emptying the queue (counted) so that nothing waits on the recorder.
+    while (!stop_.load()) {
+      {
+        std::scoped_lock lock(mutex_, stats_mutex_);
+        stats_.dropped_after_error += count_;
+        head_ = (head_ + count_) % ring_.size();
+        count_ = 0;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
   }
 }
 
@@ -229,6 +246,7 @@ void Recorder::flush(std::int64_t now_ns) {
   dirty_ = false;
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++stats_.flushes;
+  stats_.flushed_stamp_ns = stats_.last_stamp_ns;
   // How long the oldest written byte waited for this flush: what a crash just before it would have lost.
   stats_.max_flush_interval_s = std::max(stats_.max_flush_interval_s, static_cast<double>(now_ns - dirty_since_ns_) * 1e-9);
 }
@@ -303,6 +321,18 @@ RecorderStats Recorder::stats() const {
   return stats_;
 }
 
+namespace {
+// The error text inside a JSON string: no quotes, backslashes or control characters.
+std::string jsonSafe(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
+  }
+  return o;
+}
+}  // namespace
+
 std::string Recorder::summaryJson() const {
   const RecorderStats s = stats();
   std::ostringstream j;
@@ -322,13 +352,13 @@ std::string Recorder::summaryJson() const {
   for (std::size_t i = 0; i < labels().size(); ++i)
     j << (i ? ", " : "") << "\"" << labels()[i].label << "\": " << s.label_objects[i];
   const double sim_s = s.first_stamp_ns >= 0 ? static_cast<double>(s.last_stamp_ns - s.first_stamp_ns) * 1e-9 + 1e-3 : 0.0;
-  char buf[700];
+  char buf[1200];
   std::snprintf(buf, sizeof buf,
                 "}, \"dropped_samples\": %llu, \"dropped_in_queue\": %llu, \"tick_gaps\": %llu, \"objects\": %llu, "
                 "\"uncompressed_bytes\": %llu, \"file_bytes\": %llu, \"recorded_sim_s\": %.3f, \"mb_per_sim_minute\": %.3f, "
                 "\"writer_busy_s\": %.3f, \"writer_objects_per_busy_s\": %.0f, \"writer_ticks_per_busy_s\": %.0f, "
                 "\"max_queue_depth\": %zu, \"queue_capacity\": %zu, \"flushes\": %llu, \"max_unflushed_ms\": %.1f, "
-                "\"error\": \"%s\"",
+                "\"flushed_sim_s\": %.3f, \"dropped_after_error\": %llu, \"error\": \"%s\"",
                 static_cast<unsigned long long>(dropped + gaps), static_cast<unsigned long long>(dropped),
                 static_cast<unsigned long long>(gaps), static_cast<unsigned long long>(s.objects),
                 static_cast<unsigned long long>(s.uncompressed_bytes), static_cast<unsigned long long>(s.compressed_bytes),
@@ -336,7 +366,8 @@ std::string Recorder::summaryJson() const {
                 s.writer_busy_s > 0 ? static_cast<double>(s.objects) / s.writer_busy_s : 0.0,
                 s.writer_busy_s > 0 ? static_cast<double>(s.topics[0].written) / s.writer_busy_s : 0.0,
                 s.max_queue_depth, opt_.queue_capacity, static_cast<unsigned long long>(s.flushes),
-                s.max_flush_interval_s * 1e3, s.error.c_str());
+                s.max_flush_interval_s * 1e3, static_cast<double>(s.flushed_stamp_ns) * 1e-9,
+                static_cast<unsigned long long>(s.dropped_after_error), jsonSafe(s.error).c_str());
   std::string pieces = ", \"pieces\": [";
   for (std::size_t i = 0; i < s.pieces.size(); ++i) pieces += (i ? ", \"" : "\"") + s.pieces[i] + "\"";
   return j.str() + buf + pieces + "]";

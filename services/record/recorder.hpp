@@ -47,6 +47,8 @@ struct RecorderStats {
   double writer_busy_s = 0.0, max_flush_interval_s = 0.0;
   std::vector<std::string> pieces;
   std::int64_t first_stamp_ns = -1, last_stamp_ns = -1;
+  std::int64_t flushed_stamp_ns = -1;          // newest stamp on disk at the last successful flush
+  std::uint64_t dropped_after_error = 0;       // samples that arrived after the writer failed (e.g. disk full)
   std::string error;
 };
 

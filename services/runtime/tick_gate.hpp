@@ -5,7 +5,8 @@
 // the old clock had run. The gate accepts a jump of more than `max_jump` ticks ahead, or a fall back by more
 // than `max_jump` (a new clock), only when the next sample continues it: one stray sample is refused, a real
 // new timeline costs one tick. A consistent forged timeline cannot be told from a real one here: DDS
-// Security's access control keeps such writers out (docs/security.md). Pure logic, unit-tested.
+// Security's access control keeps such writers out (docs/security.md). Pure logic, unit-tested
+// (tests/faults/test_input_guards.cpp).
 #include <cstdint>
 
 namespace mft::services {
@@ -32,6 +33,7 @@ class TickGate {
     if (has_candidate_ && (tick == candidate_ + 1 || tick == candidate_)) {
       has_candidate_ = false;
       ++new_clocks_;
+      last_ = tick;  // the new timeline is adopted now, answered or not
       return ahead ? Decision::Answer : Decision::NewClock;
     }
     candidate_ = tick;

@@ -1,0 +1,197 @@
+#!/usr/bin/env python3
+"""Security tests of the stack (docs/security.md): a secured stack (services/mft-supervisor --secure, material
+from scripts/make-security.sh in a temporary directory) refuses participants without a valid identity and
+writers without permission, and still steps in place. Real processes, DDS domains 220-224, bounded in time,
+every process cleaned up (by pid, through the supervisor's `down`) even on failure."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+MAKE = REPO / "scripts" / "make-security.sh"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+SCENARIOS = REPO / "config" / "scenarios"
+DOMAIN = 220
+
+
+class SecurityTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = Path(tempfile.mkdtemp(prefix="mft-security-test-"))
+        cls.sec = cls.tmp / "sec"
+        cls.rogue = cls.tmp / "rogue"  # a second CA with the same identity names: self-consistent, not trusted
+        for d in (cls.sec, cls.rogue):
+            p = subprocess.run(["bash", str(MAKE), str(d)], capture_output=True, text=True, timeout=120)
+            if p.returncode != 0:
+                raise RuntimeError(f"make-security.sh failed: {p.stderr}")
+        cls.env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def setUp(self):
+        self.up_domains = []
+        self.procs = []
+
+    def tearDown(self):
+        for d in self.up_domains:
+            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
+                           capture_output=True, timeout=90)
+        for p in self.procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+
+    # ------------------------------------------------------------------------------------------ helpers
+    def sup(self, *args, timeout=240):
+        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
+        if args[0] in ("run", "up"):
+            cmd += ["--bin-dir", str(BIN)]
+        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        out, err = p.communicate(timeout=timeout)
+        return p.returncode, out, err
+
+    def up(self, domain, scenario, *extra):
+        self.up_domains.append(domain)
+        code, out, err = self.sup("up", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", *extra, timeout=120)
+        self.assertEqual(code, 0, err[-2000:])
+        code, out, err = self.sup("status", "--domain", domain, "--json", timeout=30)
+        return json.loads(out)
+
+    def down(self, domain, status):
+        code, out, err = self.sup("down", "--domain", domain, timeout=90)
+        self.up_domains.remove(domain)
+        self.assertEqual(code, 0, err)
+        run_dir = Path(status["run_dir"])
+        return {n: json.loads((run_dir / f"{n}.summary.json").read_text())
+                for n in ("mft-sim", "mft-wbc", "mft-estimator", "mft-planner")}
+
+    def inject(self, *args, timeout=60):
+        cmd = [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        out, err = p.communicate(timeout=timeout)
+        try:
+            return p.returncode, json.loads(out.strip().splitlines()[-1])
+        except (ValueError, IndexError):
+            self.fail(f"mft-inject printed no JSON (exit {p.returncode}): {err[-2000:]}")
+
+    # -------------------------------------------------------------------------------------------- tests
+    def test_secured_stack_refuses_strangers_and_unpermitted_writers(self):
+        domain = DOMAIN
+        st = self.up(domain, "stand.yaml", "--secure", self.sec)
+        time.sleep(1.0)
+        # (1) No identity at all: nothing matches, nothing arrives, on any topic.
+        code, r = self.inject("--domain", domain, "--listen", "all", "--seconds", 3)
+        self.assertEqual(code, 0, r)
+        self.assertEqual(sum(t["received"] for t in r["listen"].values()), 0, r)
+        self.assertEqual(sum(t["matched_writers"] for t in r["listen"].values()), 0, r)
+        # (2) A self-consistent identity of another CA (same names): authentication fails, 0 samples.
+        code, r = self.inject("--domain", domain, "--secure", self.rogue, "--identity", "record",
+                              "--listen", "SensorData,JointCommand", "--seconds", 2)
+        self.assertEqual(code, 0, r)
+        self.assertEqual(sum(t["received"] for t in r["listen"].values()), 0, r)
+        # (3) The recorder's valid identity receives: the secured topics do flow (the test can see data).
+        code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "record",
+                              "--listen", "SensorData,JointCommand", "--seconds", 2)
+        self.assertGreater(r["listen"]["SensorData"]["received"], 1000, r)
+        self.assertGreater(r["listen"]["JointCommand"]["received"], 1000, r)
+        # (4) A valid identity without permission for JointCommand (the operator tool's) is refused at
+        # writer creation, and may not read SensorData either.
+        code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "cmd", "--publish", "JointCommand",
+                              "--value", "40", "--seconds", 0.5, "--wait-match", 0)
+        self.assertEqual(code, 4, r)
+        self.assertEqual(r["participant"], "created")
+        self.assertEqual(r["writer"], "refused", r)
+        self.assertEqual(r["written"], 0)
+        code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "cmd", "--listen", "SensorData",
+                              "--seconds", 0.5)
+        self.assertEqual(code, 4, r)
+        self.assertIn("reader refused on SensorData", r["participant"])
+        # (5) Without an identity, 3 s of JointCommand at 1 kHz with 40 N m on every joint (beyond what the
+        # WBC commands at stance, within the actuators' peak): the simulator never receives one.
+        code, r = self.inject("--domain", domain, "--publish", "JointCommand", "--value", "40", "--rate", 1000,
+                              "--seconds", 3, "--wait-match", 0)
+        self.assertEqual(code, 0, r)
+        self.assertGreater(r["written"], 2000, r)
+        self.assertEqual(r["matched_readers"], 0, r)
+        s = self.down(domain, st)
+        sim, wbc = s["mft-sim"], s["mft-wbc"]
+        self.assertFalse(sim["fell"], sim.get("fall_reason"))
+        # Every command the simulator received came from the WBC (one per tick it answered, at most).
+        self.assertLessEqual(sim["commands_received"], wbc["ticks"], (sim["commands_received"], wbc["ticks"]))
+        self.assertGreater(sim["commands_received"], 5000)
+        self.assertEqual(sum(sim["commands_rejected"].values()), 0)
+        self.assertLess(abs(sim["final_base_height_m"] - 0.40), 0.01)
+        print(f"\nsecured stack: stranger listened 0 samples, stranger wrote {r['written']} JointCommands, sim received "
+              f"{sim['commands_received']} commands for {wbc['ticks']} WBC ticks, final base height "
+              f"{sim['final_base_height_m']:.4f} m", file=sys.stderr)
+
+    def test_plain_stack_would_take_the_strangers_commands(self):
+        # The same stranger on a stack without --secure: its commands do reach the simulator. This is what
+        # the secured test above rules out, and shows that the test would see an effect.
+        domain = DOMAIN + 1
+        st = self.up(domain, "stand.yaml")
+        time.sleep(1.0)
+        code, r = self.inject("--domain", domain, "--publish", "JointCommand", "--value", "40", "--rate", 1000,
+                              "--seconds", 1, "--wait-match", 5)
+        self.assertGreater(r["matched_readers"], 0, r)
+        s = self.down(domain, st)
+        sim, wbc = s["mft-sim"], s["mft-wbc"]
+        self.assertGreater(sim["commands_received"] - wbc["ticks"], 500, (sim["commands_received"], wbc["ticks"]))
+
+    def test_secured_stack_steps_in_place_in_lockstep(self):
+        code, out, err = self.sup("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
+                                  "--json", "--run-dir", self.tmp / "run-lockstep")
+        self.assertEqual(code, 0, err[-3000:])
+        s = json.loads(out)
+        self.assertTrue(s["secure"])
+        self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))
+        self.assertEqual(s["ticks"], 10000)
+        for name in ("mft-estimator", "mft-planner", "mft-wbc"):
+            self.assertEqual(s["services"][name]["ticks"], 10000, name)
+        self.assertGreater(s["services"]["mft-sim"]["touchdowns"][0], 5)
+        self.assertLess(abs(s["services"]["mft-sim"]["average_speed_mps"]), 0.05)
+        print(f"\nsecured lockstep step-in-place 10 s: wall {s['wall_time_s']} s", file=sys.stderr)
+
+    def test_bad_security_directory_is_refused_before_anything_starts(self):
+        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", self.tmp / "nope")
+        self.assertEqual(code, 2)
+        self.assertIn("is not a directory", err)
+        partial = self.tmp / "partial"
+        shutil.copytree(self.sec, partial)
+        (partial / "permissions_wbc.p7s").unlink()
+        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", partial)
+        self.assertEqual(code, 2)
+        self.assertIn("permissions_wbc.p7s", err)
+        # A service given another CA's identity with this CA's governance cannot even create its participant.
+        mixed = self.tmp / "mixed"
+        shutil.copytree(self.sec, mixed)
+        shutil.copy(self.rogue / "wbc.pem", mixed / "wbc.pem")
+        shutil.copy(self.rogue / "wbc.key", mixed / "wbc.key")
+        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", mixed, timeout=120)
+        self.assertNotEqual(code, 0)
+        self.assertIn("mft-wbc", err)
+
+    def test_make_security_refuses_the_repository(self):
+        p = subprocess.run(["bash", str(MAKE), str(REPO / "secure-test-should-not-exist")], capture_output=True, text=True)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("inside the repository", p.stderr)
+        self.assertFalse((REPO / "secure-test-should-not-exist").exists())
+        keys = sorted(self.sec.glob("*.key"))
+        self.assertEqual([k.stem for k in keys], sorted(["sim", "estimator", "planner", "wbc", "record", "cmd", "ca"]))
+        for k in keys:
+            self.assertEqual(k.stat().st_mode & 0o077, 0, k)  # private keys readable by the owner only
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -287,7 +287,7 @@ class Matrix:
                                  f"watchdog sees the gap and damps")
                 if longest and longest[2] >= 5:
                     parts.append(f"damping {longest[2]:.0f} ms after resuming")
-            elif svc in ("mft-estimator", "mft-planner", "mft-wbc", "mft-sim") and longest and longest[2] >= 5:
+            elif svc in ("mft-estimator", "mft-planner", "mft-wbc") and longest and longest[2] >= 5:
                 row.detection_ms = round(WATCHDOG_MS + longest[1], 2)
                 row.detection = f"sim watchdog: damping {row.detection_ms} ms after the last command"
                 parts.append(f"damping {longest[2]:.0f} ms")

@@ -213,6 +213,8 @@ int main(int argc, char** argv) {
   criteria.base_height_below_m = scenario.fall_base_height_m;
   criteria.pitch_beyond_rad = scenario.fall_pitch_rad;
   services::RunMonitor monitor(criteria, 1.0);
+  services::RecoveryWindow recovery(1.0);  // push-recovery judgement (tools/mft-experiment)
+  std::size_t impulses_seen = 0;
   const bool forever = cli.isSet("forever");
   const auto ticks_total = static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s));
   std::uint64_t damping_ticks = 0, startup_ticks = 0, last_progress_tick = 0, resends = 0;
@@ -310,6 +312,12 @@ int main(int argc, char** argv) {
     simulator.step();
     const bool fell_now = monitor.update(simulator.groundTruth(), commandedHeight(scenario, simulator.time()),
                                          simulator.stats().body_contact_steps);
+    {
+      const auto& st = simulator.stats();
+      for (; impulses_seen < st.impulses.size(); ++impulses_seen)
+        recovery.onImpulse(st.impulses[impulses_seen].time_s, st.impulses[impulses_seen].impulse_Ns.x());
+      recovery.update(simulator.groundTruth(), st.touchdowns[0] + st.touchdowns[1]);
+    }
     if (fell_now) {
       std::printf("mft-sim: FELL at t = %.3f s: %s\n", monitor.fallTime(), monitor.fallReason().c_str());
       std::fflush(stdout);
@@ -360,7 +368,7 @@ int main(int argc, char** argv) {
     episode_json += e;
   }
   episode_json += "]";
-  ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"latency_us\": " + latency_us.json() +
+  ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() + "}");
   return exit_code;
 }

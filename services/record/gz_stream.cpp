@@ -65,17 +65,20 @@ size_t GzReadStream::Read(void* buf, size_t n) {
   const int r = gzread(static_cast<gzFile>(file_), buf, static_cast<unsigned>(n));
   int errnum = Z_OK;
   const char* msg = gzerror(static_cast<gzFile>(file_), &errnum);
-  if (r < 0 || (errnum != Z_OK && errnum != Z_STREAM_END)) {
-    if (errnum == Z_BUF_ERROR) truncated_ = true;  // zlib: "unexpected end of file"
-    else corrupt_ = true;
-    error_ = msg ? msg : "zlib error";
+  const bool failed = errnum != Z_OK && errnum != Z_STREAM_END;
+  // zlib flags a truncated stream (Z_BUF_ERROR) as soon as its read-ahead reaches the end of the file, while
+  // up to 2 x gzbuffer of decoded data is still waiting in its buffer: the end is only where gzread returns
+  // short. Stopping at the flag lost the last ~0.1 s of a recording cut by a crash or a full disk.
+  if (r < 0 || static_cast<size_t>(r) < n) {
     eof_ = true;
-    if (r > 0) read_ += static_cast<std::uint64_t>(r);
-    return r > 0 ? static_cast<size_t>(r) : 0;
+    if (r < 0 || failed) {
+      if (errnum == Z_BUF_ERROR) truncated_ = true;  // "unexpected end of file"
+      else corrupt_ = true;
+      error_ = msg ? msg : "zlib error";
+    }
   }
-  if (static_cast<size_t>(r) < n) eof_ = true;
-  read_ += static_cast<std::uint64_t>(r);
-  return static_cast<size_t>(r);
+  if (r > 0) read_ += static_cast<std::uint64_t>(r);
+  return r > 0 ? static_cast<size_t>(r) : 0;
 }
 
 size_t GzReadStream::Write(const void*, size_t) { throw std::runtime_error("GzReadStream: Write"); }

@@ -88,7 +88,9 @@ class FaultTest(unittest.TestCase):
         s = self.down(DOMAIN, st)
         sim = s["mft-sim"]
         self.assertGreater(a["written"], 1000, a)                           # the attack ran: ~1 per tick
-        self.assertGreaterEqual(sim["commands_rejected"]["nonfinite"], 0.95 * a["written"], (sim["commands_rejected"], a))
+        # The simulator saw and refused them. Not all: a best-effort sample overwritten in the simulator's reader
+        # (history depth 1) by the next one before it was taken is never seen, more often on a loaded machine.
+        self.assertGreaterEqual(sim["commands_rejected"]["nonfinite"], 0.5 * a["written"], (sim["commands_rejected"], a))
         self.assertGreater(w["listen"]["SensorData"]["received"], 2000, w)
         self.assertEqual(w["listen"]["SensorData"]["nonfinite"], 0, w)     # the actuators' torques stayed finite
         self.assertFalse(sim["fell"], sim.get("fall_reason"))

@@ -1,0 +1,226 @@
+"""Command line of mft-experiment."""
+import argparse
+import json
+import signal
+import sys
+import time
+from pathlib import Path
+
+from . import push as _push, sweep as _sweep
+from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, check_setup, log,
+                     fmt_duration)
+
+HEIGHT_RANGE = (0.30, 0.46)
+DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the real multi-process stack, in lockstep.
+
+  push-sweep  largest recovered impulse per base height and controller (Table II): table.md/.csv, push_sweep.png
+  case        one push with both controllers, the paper's Fig. 6 as a PNG
+  terrain     blind walking over the course (board, slope, rough ground) with both controllers, Fig. 8 as a PNG
+
+Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
+keeps what finished (exit status 130) and stops every stack this tool started."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, status 2, like every other error of this tool
+        self.print_usage(sys.stderr)
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        sys.exit(2)
+
+
+def heights_list(text):
+    try:
+        hs = [round(float(x), 3) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a comma-separated list of heights: {text!r}")
+    if not hs:
+        raise argparse.ArgumentTypeError("no height given")
+    for h in hs:
+        if not HEIGHT_RANGE[0] <= h <= HEIGHT_RANGE[1]:
+            raise argparse.ArgumentTypeError(f"height {h} m is outside the planner's window {HEIGHT_RANGE} m")
+    return hs
+
+
+def controllers_list(text):
+    cs = [x.strip() for x in text.split(",") if x.strip()]
+    for c in cs:
+        if c not in ("mft", "sa", "none"):
+            raise argparse.ArgumentTypeError(f"unknown controller {c!r} (mft, sa or none)")
+    if not cs:
+        raise argparse.ArgumentTypeError("no controller given")
+    return cs
+
+
+def positive(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}")
+    if not v > 0 or v != v or v == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive number: {text!r}")
+    return v
+
+
+def height(text):
+    return heights_list(text)[0]
+
+
+def domain_id(text):
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}")
+    if not 0 <= v <= 232:
+        raise argparse.ArgumentTypeError(f"DDS domain id must be 0..232: {v}")
+    return v
+
+
+def add_common(p, workers=True):
+    p.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
+    p.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help="configuration folder (default %(default)s)")
+    p.add_argument("--domain-base", type=domain_id, default=100,
+                   help="DDS domain of the first stack; stack i uses domain-base + i (default %(default)s)")
+    if workers:
+        p.add_argument("--workers", type=int, default=2, choices=range(1, 9), metavar="N",
+                       help="stacks run in parallel, one per core (default %(default)s)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def add_push_setup(p):
+    g = p.add_argument_group("push and recovery criteria")
+    g.add_argument("--direction", choices=("forward", "backward"), default="forward", help="push direction (default forward)")
+    g.add_argument("--liftoff", choices=("right", "left"), default="right",
+                   help="the push comes right after this foot lifts off (default right)")
+    g.add_argument("--push-after", type=positive, default=3.0,
+                   help="the push is armed at this time [s] (stepping starts at 1 s) and applied at the next lift-off")
+    g.add_argument("--observe", type=positive, default=5.0,
+                   help="run length after --push-after [s]; the last 1 s is the recovery window (default 5)")
+    g.add_argument("--max-speed", type=positive, default=0.05,
+                   help="recovered: |mean base speed| over the last 1 s at most this [m/s] (default 0.05)")
+    g.add_argument("--height-band", type=positive, default=0.02,
+                   help="recovered: mean base height over the last 1 s within this of the second before the push [m]")
+    g.add_argument("--max-pitch", type=positive, default=0.1, help="recovered: |pitch| over the last 1 s [rad]")
+    g.add_argument("--min-touchdowns", type=int, default=2, help="recovered: touchdowns in the last 1 s (still stepping)")
+
+
+def make_setup(args):
+    from .push import PushSetup, Criteria
+    if args.observe < 2.0:
+        raise ExperimentError("--observe must be at least 2 s (the recovery window is the last 1 s)")
+    return PushSetup(push_after_s=args.push_after, observe_s=args.observe, liftoff=args.liftoff,
+                     direction=args.direction,
+                     criteria=Criteria(max_speed_mps=args.max_speed, height_band_m=args.height_band,
+                                       max_pitch_rad=args.max_pitch, min_touchdowns=args.min_touchdowns))
+
+
+def build_parser():
+    p = Parser(prog="mft-experiment", description=DESCRIPTION,
+               formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain}", parser_class=Parser)
+    sub.required = True
+
+    s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
+                       description=_sweep.__doc__ + "\n" + _push.__doc__,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    s.add_argument("--heights", type=heights_list, default=[0.38, 0.40, 0.42, 0.44, 0.46],
+                   help="reference base heights [m], comma-separated (default 0.38,0.40,0.42,0.44,0.46)")
+    s.add_argument("--controllers", type=controllers_list, default=["sa", "mft"], help="default sa,mft")
+    s.add_argument("--start", type=positive, default=3.0, help="first impulse [N s] (default 3, the paper's)")
+    s.add_argument("--step", type=positive, default=0.1, help="impulse grid step [N s] (default 0.1, the paper's)")
+    s.add_argument("--max-impulse", type=positive, default=30.0, help="largest impulse tried [N s] (default 30)")
+    s.add_argument("--search", choices=("bisect", "linear"), default="bisect",
+                   help="bisect with a monotonicity check (default) or the paper's linear scan")
+    s.add_argument("--no-rawlogs", dest="keep_rawlogs", action="store_false",
+                   help="do not keep the rawlogs of each cell's boundary runs")
+    s.add_argument("--out", help="output folder; an existing one is resumed (default runs/experiment-<time>)")
+    add_push_setup(s)
+    add_common(s)
+
+    c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
+                       description="One push at one height with both controllers (recorded), and the paper's "
+                                   "Fig. 6 as a PNG: hip joint angles of both legs; base height, pitch and speed.")
+    c.add_argument("--height", type=height, default=0.44, help="reference base height [m] (default 0.44)")
+    c.add_argument("--impulse", type=positive, default=7.1, help="impulse [N s] (default 7.1, the paper's case)")
+    c.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
+    c.add_argument("--out", help="output folder (default runs/case-<time>)")
+    add_push_setup(c)
+    add_common(c)
+
+    t = sub.add_parser("terrain", help="blind walking over the course with both controllers, the paper's Fig. 8",
+                       description="Blind walking over config/terrain/<terrain>.yaml (3 cm board, 6 degree slope, "
+                                   "about 2 cm rough ground) with both controllers, recorded. Success = the base "
+                                   "passed the end of the course without a fall. Reports whether the left leg stayed "
+                                   "inside the MFT preferable space (config/mft_space.yaml leg polygon) while in "
+                                   "stance on the up-slope, and draws the paper's Fig. 8.")
+    t.add_argument("--speed", type=positive, default=0.3, help="commanded walking speed [m/s] (default 0.3)")
+    t.add_argument("--height", type=height, default=0.42, help="reference base height [m] (default 0.42)")
+    t.add_argument("--terrain", default="course", help="terrain file under config/terrain (default course)")
+    t.add_argument("--duration", type=positive, help="run length [s] (default: enough to pass the course)")
+    t.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
+    t.add_argument("--out", help="output folder (default runs/terrain-<time>)")
+    add_common(t)
+    return p
+
+
+def cmd_push_sweep(args):
+    from .sweep import Sweep
+    from . import report
+    from dataclasses import asdict
+    if args.step > 5 or args.start > args.max_impulse:
+        raise ExperimentError("need --start <= --max-impulse and --step <= 5 N s")
+    if args.max_impulse > 100:
+        raise ExperimentError("--max-impulse is at most 100 N s (the scenario format's limit)")
+    setup = make_setup(args)
+    args.out = args.out or str(REPO / "runs" / f"experiment-{time.strftime('%Y%m%d-%H%M%S')}")
+    sweep = Sweep(args, setup)
+    log(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
+        f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), {args.workers} stacks on "
+        f"domains {args.domain_base}..{args.domain_base + args.workers - 1}")
+    wall = None
+    try:
+        wall = sweep.run()
+    finally:
+        table = report.write_tables(args.out, sweep.results, args.heights, args.controllers, args.direction,
+                                    sweep.grid, asdict(setup), wall)
+    png = report.plot_sweep(args.out, table, args.direction)
+    summary = report.summary_json(table, sweep.results, sweep.grid, asdict(setup), wall, sweep.new_runs)
+    summary.update({"out": args.out, "table_md": str(Path(args.out) / "table.md"),
+                    "table_csv": str(Path(args.out) / "table.csv"), "plot": str(png)})
+    (Path(args.out) / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    log(f"done in {fmt_duration(wall)} ({sweep.new_runs} new runs): {args.out}/table.md, table.csv, push_sweep.png")
+    if args.json:
+        print(json.dumps(summary, indent=1))
+    else:
+        print((Path(args.out) / "table.md").read_text())
+    return 0
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+
+    def on_term(*_):
+        raise KeyboardInterrupt()
+    signal.signal(signal.SIGTERM, on_term)
+    try:
+        check_setup(args.bin_dir, args.config_dir,
+                    need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
+                         (("mft-record", "mft-export") if args.command != "push-sweep" or args.keep_rawlogs else ()))
+        if args.command == "push-sweep":
+            return cmd_push_sweep(args)
+        if args.command == "case":
+            from .case import cmd_case
+            return cmd_case(args, make_setup(args))
+        if args.command == "terrain":
+            from .terrain import cmd_terrain
+            return cmd_terrain(args)
+    except ExperimentError as e:
+        REGISTRY.stop_all()
+        print(f"mft-experiment: error: {e}", file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, Interrupted):
+        REGISTRY.stop_all()
+        print("mft-experiment: interrupted; finished runs are kept (run the same command to resume)", file=sys.stderr)
+        return 130
+    return 0

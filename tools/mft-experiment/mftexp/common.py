@@ -1,0 +1,240 @@
+"""Shared pieces: errors, paths, binaries, process handling and progress lines."""
+import ctypes
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+DEFAULT_CONFIG = REPO / "config"
+DEFAULT_BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
+
+# The paper's Table II (section IV-B): I_max [N s] per reference height, SA-WBC and MFT-WBC.
+PAPER_TABLE2 = {
+    0.38: {"sa": 10.4, "mft": 10.7, "increase_pct": 2.9},
+    0.40: {"sa": 9.7, "mft": 10.6, "increase_pct": 9.3},
+    0.42: {"sa": 9.1, "mft": 10.6, "increase_pct": 16.5},
+    0.44: {"sa": 7.0, "mft": 9.5, "increase_pct": 35.6},
+    0.46: {"sa": 4.5, "mft": 6.6, "increase_pct": 44.4},
+}
+CONTROLLER_NAMES = {"mft": "MFT-WBC", "sa": "SA-WBC", "none": "no MFT, no SA"}
+
+
+class ExperimentError(Exception):
+    """A problem reported as one clear line (exit status 2), never a traceback."""
+
+
+class Interrupted(Exception):
+    """Ctrl-C or SIGTERM: what finished is kept, the runs in flight are stopped."""
+
+
+def log(msg):
+    print(f"mft-experiment: {msg}", file=sys.stderr, flush=True)
+
+
+def fmt_duration(s):
+    s = int(round(max(0.0, s)))
+    return f"{s // 60}:{s % 60:02d}" if s < 3600 else f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+
+def check_setup(bin_dir, config_dir, need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc")):
+    bin_dir, config_dir = Path(bin_dir), Path(config_dir)
+    if not SUPERVISOR.is_file():
+        raise ExperimentError(f"the supervisor {SUPERVISOR} is missing")
+    if not bin_dir.is_dir():
+        raise ExperimentError(f"binary folder {bin_dir} does not exist (build first: cmake --build build/release)")
+    for name in need:
+        p = bin_dir / name
+        if not (p.is_file() and os.access(p, os.X_OK)):
+            raise ExperimentError(f"{p} is missing or not executable (build first: cmake --build build/release)")
+    if not (config_dir / "robot.yaml").is_file():
+        raise ExperimentError(f"configuration folder {config_dir} has no robot.yaml")
+
+
+def _pdeathsig_term():
+    # Runs in the child between fork and exec: a supervisor gets SIGTERM (and stops its stack) when we die.
+    try:
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    except OSError:
+        pass
+
+
+class ProcessRegistry:
+    """The supervisors this tool started (and only those): stopped by pid on Ctrl-C or an error."""
+
+    def __init__(self):
+        self._lock = threading.Lock()
+        self._procs = set()
+        self.stopping = threading.Event()
+
+    def popen(self, argv, **kw):
+        with self._lock:
+            if self.stopping.is_set():
+                raise Interrupted()
+            p = subprocess.Popen(argv, stdin=subprocess.DEVNULL, start_new_session=True,
+                                 preexec_fn=_pdeathsig_term, **kw)
+            self._procs.add(p)
+            return p
+
+    def done(self, p):
+        with self._lock:
+            self._procs.discard(p)
+
+    def stop_all(self, grace_s=15.0):
+        self.stopping.set()
+        with self._lock:
+            procs = list(self._procs)
+        for p in procs:
+            if p.poll() is None:
+                try:
+                    os.kill(p.pid, signal.SIGTERM)  # the supervisor stops its own children
+                except OSError:
+                    pass
+        deadline = time.monotonic() + grace_s
+        for p in procs:
+            try:
+                p.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                try:
+                    os.kill(p.pid, signal.SIGKILL)  # its children die with it (PR_SET_PDEATHSIG)
+                except OSError:
+                    pass
+                p.wait()
+
+
+REGISTRY = ProcessRegistry()
+
+
+def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=None, timeout_s=600.0):
+    """One lockstep run through the supervisor. Returns (summary dict, wall seconds); raises ExperimentError
+    when the stack itself failed (not when the robot fell) and Interrupted when stopping."""
+    argv = [sys.executable, str(SUPERVISOR), "run", str(scenario_path), "--domain", str(domain), "--json",
+            "--bin-dir", str(bin_dir), "--config-dir", str(config_dir), "--run-dir", str(run_dir)]
+    if record:
+        argv += ["--record", str(record)]
+    env = dict(os.environ, MFT_RUNS_DIR=str(Path(run_dir).parent))
+    t0 = time.monotonic()
+    p = REGISTRY.popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        out, err = p.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        p.terminate()
+        out, err = p.communicate()
+        raise ExperimentError(f"run {scenario_path} did not end within {timeout_s:.0f} s (logs in {run_dir})")
+    finally:
+        REGISTRY.done(p)
+    wall = time.monotonic() - t0
+    if REGISTRY.stopping.is_set():
+        raise Interrupted()
+    try:
+        summary = json.loads(out)
+    except ValueError:
+        last = (err.strip().splitlines() or ["no output"])[-1]
+        raise ExperimentError(f"supervisor failed on {scenario_path} (status {p.returncode}): {last}")
+    if not summary.get("ok"):
+        raise ExperimentError(f"stack failed on {scenario_path}: {summary.get('error') or summary.get('failed')} "
+                              f"(logs in {run_dir})")
+    sim = (summary.get("services") or {}).get("mft-sim") or {}
+    if "recovery" not in sim:
+        raise ExperimentError("mft-sim's summary has no 'recovery' section: rebuild mft-sim "
+                              "(cmake --build build/release --target mft-sim)")
+    return summary, wall
+
+
+def write_yaml_scenario(path, s):
+    """Writes a scenario dict in the flow style of config/scenarios (no yaml dependency needed)."""
+    def v(x):
+        if isinstance(x, bool):
+            return "true" if x else "false"
+        if isinstance(x, float):
+            return repr(round(x, 6))
+        if isinstance(x, str) and x.replace("_", "").replace("-", "").replace(".", "").isalnum():
+            return x
+        return json.dumps(str(x))  # a JSON string is a valid YAML double-quoted scalar
+    lines = [f"# generated by mft-experiment", "schema_version: 1"]
+    for k in ("name", "description", "duration_s", "controller", "estimator", "terrain", "initial_base_height_m"):
+        lines.append(f"{k}: {v(s[k])}")
+    lines.append("fall:")
+    for k, x in s["fall"].items():
+        lines.append(f"  {k}: {v(x)}")
+    lines.append("commands:")
+    for c in s["commands"]:
+        lines.append("  - {" + ", ".join(f"{k}: {v(x)}" for k, x in c.items()) + "}")
+    if s.get("pushes"):
+        lines.append("pushes:")
+        for c in s["pushes"]:
+            lines.append("  - {" + ", ".join(f"{k}: {v(x)}" for k, x in c.items()) + "}")
+    Path(path).write_text("\n".join(lines) + "\n")
+
+
+def check_scenario(bin_dir, config_dir, path):
+    p = subprocess.run([str(Path(bin_dir) / "mft-sim"), "--check-scenario", str(path), "--config-dir", str(config_dir),
+                        "--json"], capture_output=True, text=True, timeout=60)
+    if p.returncode != 0:
+        raise ExperimentError(f"generated scenario {path} is invalid: {(p.stderr or p.stdout).strip()}")
+
+
+def export_csv(bin_dir, rawlog, out_dir, labels):
+    p = subprocess.run([str(Path(bin_dir) / "mft-export"), str(rawlog), "--csv", str(out_dir), "--labels",
+                        ",".join(labels)], capture_output=True, text=True, timeout=600)
+    if p.returncode not in (0,):
+        raise ExperimentError(f"mft-export failed on {rawlog}: {(p.stderr or p.stdout).strip()[-300:]}")
+
+
+def read_csv(path):
+    """A numeric CSV of mft-export as {column: list of floats}."""
+    import csv
+    with open(path) as f:
+        r = csv.reader(f)
+        header = next(r)
+        cols = {h: [] for h in header}
+        for row in r:
+            for h, x in zip(header, row):
+                cols[h].append(float(x))
+    return cols
+
+
+class Progress:
+    """Progress lines with an estimate of the time left, on stderr."""
+
+    def __init__(self, workers, quiet=False):
+        self.workers = max(1, workers)
+        self.quiet = quiet
+        self.lock = threading.Lock()
+        self.t0 = time.monotonic()
+        self.walls = []
+        self.runs_done = 0
+
+    def run_finished(self, wall_s, text, remaining_runs):
+        with self.lock:
+            self.walls.append(wall_s)
+            self.runs_done += 1
+            mean = sum(self.walls) / len(self.walls)
+            eta = remaining_runs * mean / self.workers
+            if not self.quiet:
+                print(f"[{fmt_duration(time.monotonic() - self.t0)} elapsed, ~{fmt_duration(eta)} left, "
+                      f"{self.runs_done} runs] {text}", file=sys.stderr, flush=True)
+
+    def note(self, text):
+        if not self.quiet:
+            with self.lock:
+                print(f"[{fmt_duration(time.monotonic() - self.t0)}] {text}", file=sys.stderr, flush=True)
+
+
+def pyplot():
+    """matplotlib's pyplot (Agg), or a clear error."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ExperimentError(f"matplotlib is missing for {sys.executable} (Debian: apt-get install python3-matplotlib; "
+                              f"run with /usr/bin/python3)")
+    return plt

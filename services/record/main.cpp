@@ -287,7 +287,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<RecorderParticipant> participant;
   try {
     participant = std::make_unique<RecorderParticipant>(
-        domain, config_file("dds_profiles.xml"),
+        domain, services::ServiceContext::profilesFile(cli),
         static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024),
         services::SecurityOptions{cli.get("secure"), "record"});
   } catch (const services::DdsError& e) {

@@ -15,6 +15,13 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
+  cli.option("profiles", "DDS QoS profile file (default: dds_profiles.xml of --config-dir; a multi-host stack gives "
+             "each host its own: its address, its peers or discovery server, docs/distributed.md)");
+}
+
+std::string ServiceContext::profilesFile(const CommandLine& cli) {
+  const std::string file = cli.get("profiles");
+  return file.empty() ? cli.get("config-dir") + "/dds_profiles.xml" : file;
 }
 
 ServiceContext::ServiceContext(const std::string& service, const CommandLine& cli) : service_(service) {
@@ -33,7 +40,7 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   }
   if (cli.isSet("rt")) tryRealtimeScheduling(80);
   try {
-    participant_ = std::make_unique<DdsParticipant>(domain, configFile("dds_profiles.xml"), service,
+    participant_ = std::make_unique<DdsParticipant>(domain, profilesFile(cli), service,
                                                     SecurityOptions{cli.get("secure"), securityIdentity(service)});
   } catch (const DdsError& e) {
     cli.fail(e.what());

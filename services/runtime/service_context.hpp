@@ -18,6 +18,8 @@ class ServiceContext {
  public:
   // Declares the common options on `cli`; call before cli.parse().
   static void declareOptions(CommandLine& cli);
+  // The DDS profile file of a parsed command line: --profiles, else dds_profiles.xml of --config-dir.
+  static std::string profilesFile(const CommandLine& cli);
   // After cli.parse(): loads the configuration and creates the participant. Exits 2 with a clear message on
   // any configuration error (nothing is started).
   ServiceContext(const std::string& service, const CommandLine& cli);

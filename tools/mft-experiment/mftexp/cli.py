@@ -8,7 +8,7 @@ from pathlib import Path
 
 from . import push as _push, sweep as _sweep
 from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, check_setup, log,
-                     fmt_duration)
+                     fmt_duration, snapshot_binaries)
 
 HEIGHT_RANGE = (0.30, 0.46)
 DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the real multi-process stack, in lockstep.
@@ -83,6 +83,9 @@ def add_common(p, workers=True):
     if workers:
         p.add_argument("--workers", type=int, default=2, choices=range(1, 9), metavar="N",
                        help="stacks run in parallel, one per core (default %(default)s)")
+    p.add_argument("--no-snapshot", dest="snapshot", action="store_false",
+                   help="use --bin-dir directly instead of a copy of its services in OUT/bin (the copy keeps a "
+                        "rebuild of the shared build folder from breaking or changing a running experiment)")
     p.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
 
@@ -163,6 +166,12 @@ def build_parser():
     return p
 
 
+def use_snapshot(args):
+    if args.snapshot:
+        Path(args.out).mkdir(parents=True, exist_ok=True)
+        args.bin_dir = str(snapshot_binaries(args.bin_dir, Path(args.out) / "bin"))
+
+
 def cmd_push_sweep(args):
     from .sweep import Sweep
     from . import report
@@ -173,6 +182,7 @@ def cmd_push_sweep(args):
         raise ExperimentError("--max-impulse is at most 100 N s (the scenario format's limit)")
     setup = make_setup(args)
     args.out = args.out or str(REPO / "runs" / f"experiment-{time.strftime('%Y%m%d-%H%M%S')}")
+    use_snapshot(args)
     sweep = Sweep(args, setup)
     log(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
         f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), {args.workers} stacks on "
@@ -209,6 +219,9 @@ def main(argv=None):
                          (("mft-record", "mft-export") if args.command != "push-sweep" or args.keep_rawlogs else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
+        if args.command in ("case", "terrain"):
+            args.out = args.out or str(REPO / "runs" / f"{args.command}-{time.strftime('%Y%m%d-%H%M%S')}")
+            use_snapshot(args)
         if args.command == "case":
             from .case import cmd_case
             return cmd_case(args, make_setup(args))

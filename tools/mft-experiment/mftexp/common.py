@@ -57,6 +57,37 @@ def check_setup(bin_dir, config_dir, need=("mft-sim", "mft-estimator", "mft-plan
         raise ExperimentError(f"configuration folder {config_dir} has no robot.yaml")
 
 
+SNAPSHOT = ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record", "mft-export")
+
+
+def snapshot_binaries(bin_dir, dest):
+    """Copies the services (and the supervisor) into dest once, so that a rebuild of the shared build folder
+    during a long experiment can neither break nor change it. Returns the folder to use as --bin-dir."""
+    import shutil
+    global SUPERVISOR
+    dest = Path(dest)
+    if not (dest / "mft-sim").is_file():
+        tmp = dest.with_name(dest.name + ".tmp")
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        for name in SNAPSHOT:
+            src = Path(bin_dir) / name
+            if not src.is_file():
+                continue
+            for _ in range(10):  # a file being relinked right now: wait until it is stable
+                before = src.stat()
+                shutil.copy2(src, tmp / name)
+                after = src.stat()
+                if (before.st_mtime_ns, before.st_size) == (after.st_mtime_ns, after.st_size) and \
+                        after.st_mtime_ns < time.time_ns() - 2_000_000_000:
+                    break
+                time.sleep(2.0)
+        shutil.copy2(SUPERVISOR, tmp / "mft-supervisor")
+        tmp.rename(dest)
+    SUPERVISOR = dest / "mft-supervisor"
+    return dest
+
+
 def _pdeathsig_term():
     # Runs in the child between fork and exec: a supervisor gets SIGTERM (and stops its stack) when we die.
     try:

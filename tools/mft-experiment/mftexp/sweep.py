@@ -38,6 +38,7 @@ class ResultsFile:
         self.path = Path(path)
         self.lock = threading.Lock()
         self.runs, self.cells, self.records = {}, {}, {}
+        self.resumed = self.path.exists()
         if self.path.exists():
             self._load(header)
         else:
@@ -149,15 +150,16 @@ class Sweep:
         if not self.checked_scenario:
             check_scenario(self.args.bin_dir, self.args.config_dir, scen)
             self.checked_scenario = True
-        for attempt in (1, 2):
+        for attempt in (1, 2, 3):
             try:
                 summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.args.config_dir, record=record,
                                              timeout_s=self.setup.duration_s * 30 + 120)
                 break
             except ExperimentError as e:
-                if attempt == 2 or REGISTRY.stopping.is_set():
+                if attempt == 3 or REGISTRY.stopping.is_set():
                     raise
-                log(f"{e}; retrying once")
+                log(f"{e}; retrying ({attempt} of 2)")
+                time.sleep(3.0 * attempt)
         sim = summary["services"]["mft-sim"]
         recovered, reason = pushmod.judge(sim, self.setup.criteria)
         if recovered is None:
@@ -300,7 +302,7 @@ class Sweep:
     # ------------------------------------------------------------------------------------------------- all
     def run(self):
         todo = [c for c in self.cells if c not in self.results.cells]
-        if len(todo) < len(self.cells):
+        if self.results.resumed:
             log(f"resuming {self.out / 'results.jsonl'}: {len(self.cells) - len(todo)} of {len(self.cells)} cells "
                 f"done, {len(self.results.runs)} runs on file")
         queue = list(todo)

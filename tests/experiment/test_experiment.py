@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+"""mft-experiment push-sweep on real lockstep stacks, reduced (issue 9): one height (0.44 m), both controllers,
+1 N s steps. Checks the table's shape (table.csv, table.md), that every cell's boundary is bracketed by a
+recovered and a failed run of results.jsonl one grid step apart, that the kept rawlogs exist and reproduced their
+runs; that an interrupted sweep (SIGINT) leaves no process behind and resumes to the same table without
+re-running a finished run; and clear one-line errors on bad arguments. DDS domains 150-153."""
+import csv
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent.parent
+TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+HEIGHT = "0.44"
+SWEEP = ["push-sweep", "--heights", HEIGHT, "--step", "1.0", "--max-impulse", "20", "--bin-dir", str(BIN)]
+
+
+def tool(*args, timeout=600):
+    return subprocess.run([sys.executable, str(TOOL)] + [str(a) for a in args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def lines(path):
+    return [json.loads(l) for l in Path(path).read_text().splitlines() if l.strip()]
+
+
+def processes_mentioning(text):
+    """pids of processes whose command line mentions text (the test's own folders)."""
+    found = []
+    for p in Path("/proc").iterdir():
+        if not p.name.isdigit() or int(p.name) == os.getpid():
+            continue
+        try:
+            cmd = (p / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if text in cmd:
+            found.append((int(p.name), cmd[:200]))
+    return found
+
+
+class ExperimentTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = Path(tempfile.mkdtemp(prefix="mft-experiment-test-"))
+        cls.full = cls.tmp / "full"
+        t0 = time.monotonic()
+        cls.res = tool(*SWEEP, "--out", cls.full, "--domain-base", 150, "--json")
+        cls.wall = time.monotonic() - t0
+        print(f"reduced sweep: {cls.wall:.1f} s", file=sys.stderr)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def test_1_table_shape_and_brackets(self):
+        self.assertEqual(self.res.returncode, 0, self.res.stderr[-2000:])
+        summary = json.loads(self.res.stdout)
+        self.assertIn("left", self.res.stderr)  # progress lines with the time left
+        with open(self.full / "table.csv") as f:
+            rows = list(csv.DictReader(f))
+        self.assertEqual(len(rows), 1)
+        self.assertEqual(rows[0]["height_m"], HEIGHT)
+        for col in ("sa_imax_Ns", "mft_imax_Ns", "increase_pct", "paper_sa_imax_Ns", "paper_mft_imax_Ns"):
+            self.assertIn(col, rows[0])
+        md = (self.full / "table.md").read_text()
+        for row in ("I_max of SA-WBC", "I_max of MFT-WBC", "Percentage of increase"):
+            self.assertIn(row, md)
+        self.assertTrue((self.full / "push_sweep.png").stat().st_size > 1000)
+        recs = lines(self.full / "results.jsonl")
+        self.assertEqual(recs[0]["kind"], "sweep")
+        runs = {(r["controller"], round(r["impulse_Ns"], 3)): r for r in recs if r["kind"] == "run"}
+        cells = [r for r in recs if r["kind"] == "cell"]
+        self.assertEqual(sorted(c["controller"] for c in cells), ["mft", "sa"])
+        for c in cells:
+            self.assertEqual(c["status"], "ok", c)
+            lo, hi = c["recovered_Ns"], c["failed_Ns"]
+            self.assertAlmostEqual(hi - lo, 1.0, places=6)
+            self.assertTrue(runs[(c["controller"], round(lo, 3))]["recovered"], c)
+            self.assertFalse(runs[(c["controller"], round(hi, 3))]["recovered"], c)
+            self.assertEqual(c["i_max_Ns"], lo)
+            csv_val = float(rows[0][f"{c['controller']}_imax_Ns"])
+            self.assertAlmostEqual(csv_val, lo, places=6)
+            # kept rawlogs of both boundary runs, re-run with identical outcomes (lockstep determinism)
+            self.assertEqual(set(c["rawlogs"]), {"recovered", "failed"})
+            for p in c["rawlogs"].values():
+                self.assertTrue(Path(p).stat().st_size > 10000, p)
+            self.assertTrue(c["deterministic"], c)
+        self.assertEqual(len(summary["table"]), 1)
+        self.assertEqual(processes_mentioning(str(self.tmp)), [])
+
+    def test_2_interrupt_and_resume(self):
+        out = self.tmp / "resume"
+        args = SWEEP + ["--out", str(out), "--domain-base", "152", "--no-rawlogs"]
+        p = subprocess.Popen([sys.executable, str(TOOL)] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+        results = out / "results.jsonl"
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            if results.exists() and sum(1 for r in lines(results) if r["kind"] == "run") >= 4:
+                break
+            time.sleep(0.2)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=60)
+        self.assertEqual(p.returncode, 130, err[-2000:])
+        self.assertIn("interrupted", err)
+        self.assertNotIn("Traceback", err)
+        time.sleep(0.5)
+        self.assertEqual(processes_mentioning(str(out)), [])  # no stack left behind
+        before = [r for r in lines(results) if r["kind"] == "run"]
+        self.assertGreaterEqual(len(before), 4)
+        res = tool(*args, "--json")
+        self.assertEqual(res.returncode, 0, res.stderr[-2000:])
+        self.assertIn("resuming", res.stderr)
+        summary = json.loads(res.stdout)
+        after = [r for r in lines(results) if r["kind"] == "run"]
+        keys = [(r["controller"], round(r["impulse_Ns"], 3)) for r in after]
+        self.assertEqual(len(keys), len(set(keys)), "a finished run was run again")
+        self.assertEqual(summary["new_runs"], len(after) - len(before))
+        # the same table as the uninterrupted sweep
+        with open(out / "table.csv") as f1, open(self.full / "table.csv") as f2:
+            self.assertEqual(f1.read(), f2.read())
+
+    def test_3_clear_errors(self):
+        cases = [
+            (["push-sweep", "--heights", "0.9"], "outside"),
+            (["push-sweep", "--step", "abc"], "not a number"),
+            (["push-sweep", "--controllers", "pid"], "unknown controller"),
+            (["case", "--impulse", "-3"], "positive"),
+            (["push-sweep", "--bin-dir", str(self.tmp / "nope"), "--out", str(self.tmp / "x")], "does not exist"),
+            (["terrain", "--terrain", "nope", "--bin-dir", str(BIN)], "does not exist"),
+            (["push-sweep", "--heights", HEIGHT, "--step", "0.5", "--out", str(self.full), "--bin-dir", str(BIN)],
+             "other settings"),
+            (["bogus"], "invalid choice"),
+        ]
+        notours = self.tmp / "notours"
+        notours.mkdir()
+        (notours / "results.jsonl").write_text("hello\n")
+        cases.append((["push-sweep", "--out", str(notours), "--bin-dir", str(BIN)], "not a"))
+        for argv, text in cases:
+            r = tool(*argv, timeout=60)
+            self.assertEqual(r.returncode, 2, f"{argv}: {r.returncode} {r.stderr}")
+            self.assertIn(text, r.stderr, argv)
+            self.assertNotIn("Traceback", r.stderr, argv)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,0 +1,161 @@
+"""case: one push at one height with each controller (recorded), and the paper's Fig. 6 as a PNG."""
+import json
+import threading
+import time
+from pathlib import Path
+
+from .common import (CONTROLLER_NAMES, REPO, REGISTRY, ExperimentError, Interrupted, check_scenario, export_csv, log,
+                     pyplot, read_csv, run_scenario)
+from . import push as pushmod
+
+COLORS = {"mft": "tab:blue", "sa": "tab:orange", "none": "tab:gray"}
+
+
+def run_pair(args, jobs):
+    """Runs [(name, scenario, run_dir, rawlog)] on args.workers stacks; returns {name: (summary, wall)}."""
+    results, errors = {}, []
+    queue = list(jobs)
+    lock = threading.Lock()
+
+    def worker(i):
+        while not REGISTRY.stopping.is_set():
+            with lock:
+                if not queue:
+                    return
+                name, scen, rd, rawlog, timeout = queue.pop(0)
+            try:
+                t0 = time.monotonic()
+                if not args.quiet:
+                    log(f"{name}: running on domain {args.domain_base + i} (recording to {rawlog.name})")
+                results[name] = run_scenario(scen, rd, args.domain_base + i, args.bin_dir, args.config_dir,
+                                             record=rawlog, timeout_s=timeout)
+                if not args.quiet:
+                    log(f"{name}: done in {time.monotonic() - t0:.1f} s")
+            except Interrupted:
+                return
+            except BaseException as e:  # noqa: reported by the caller
+                errors.append(e)
+                REGISTRY.stop_all()
+                return
+
+    threads = [threading.Thread(target=worker, args=(i,), daemon=True) for i in range(max(1, args.workers))]
+    for t in threads:
+        t.start()
+    try:
+        while any(t.is_alive() for t in threads):
+            for t in threads:
+                t.join(timeout=0.2)
+    except KeyboardInterrupt:
+        REGISTRY.stop_all()
+        raise Interrupted()
+    if errors:
+        raise errors[0] if isinstance(errors[0], ExperimentError) else ExperimentError(str(errors[0]))
+    if REGISTRY.stopping.is_set():
+        raise Interrupted()
+    return results
+
+
+def cmd_case(args, setup):
+    out = Path(args.out or REPO / "runs" / f"case-{time.strftime('%Y%m%d-%H%M%S')}")
+    out.mkdir(parents=True, exist_ok=True)
+    jobs = []
+    for c in args.controllers:
+        rd = out / f"{c}-run"
+        rd.mkdir(exist_ok=True)
+        scen = rd / "scenario.yaml"
+        pushmod.write_scenario(scen, setup, args.height, c, args.impulse)
+        check_scenario(args.bin_dir, args.config_dir, scen)
+        jobs.append((c, scen, rd, out / f"{c}.rawlog", setup.duration_s * 40 + 120))
+    t0 = time.monotonic()
+    runs = run_pair(args, jobs)
+    report = {"height_m": args.height, "impulse_Ns": args.impulse, "direction": setup.direction,
+              "liftoff": setup.liftoff, "controllers": {}, "out": str(out)}
+    traces = {}
+    for c in args.controllers:
+        summary, wall = runs[c]
+        sim = summary["services"]["mft-sim"]
+        recovered, reason = pushmod.judge(sim, setup.criteria)
+        csv_dir = out / f"{c}-csv"
+        export_csv(args.bin_dir, out / f"{c}.rawlog", csv_dir, ["gt_q", "gt_qd", "leg_lti"])
+        traces[c] = {"q": read_csv(csv_dir / "gt_q.csv"), "qd": read_csv(csv_dir / "gt_qd.csv"),
+                     "lti": read_csv(csv_dir / "leg_lti.csv")}
+        rec = sim["recovery"]
+        report["controllers"][c] = {
+            "recovered": recovered, "reason": reason, "fell": sim.get("fell"), "fall_time_s": sim.get("fall_time_s"),
+            "fall_reason": sim.get("fall_reason"), "push_time_s": rec.get("push_time_s"),
+            "pre_mean_base_height_m": rec["pre"]["mean_base_height_m"] if rec.get("pre") else None,
+            "after": rec.get("after"), "tail": rec.get("tail"), "rawlog": str(out / f"{c}.rawlog"),
+            "wall_s": round(wall, 2)}
+    png = plot_case(out / "case.png", args, setup, report, traces)
+    report["plot"] = str(png)
+    report["wall_s"] = round(time.monotonic() - t0, 1)
+    (out / "case.json").write_text(json.dumps(report, indent=1) + "\n")
+    if args.json:
+        print(json.dumps(report, indent=1))
+    else:
+        print(f"case: {args.impulse:g} N s {setup.direction} at {args.height:.2f} m ({setup.liftoff}-foot lift-off)")
+        for c, r in report["controllers"].items():
+            print(f"  {CONTROLLER_NAMES.get(c, c):8s} push at {r['push_time_s']:.3f} s: "
+                  f"{'RECOVERED' if r['recovered'] else 'NOT RECOVERED'} ({r['reason']})")
+        print(f"  figure {png}; rawlogs and CSV in {out}")
+    return 0
+
+
+def plot_case(path, args, setup, report, traces):
+    plt = pyplot()
+    fig, axes = plt.subplots(2, 3, figsize=(13, 6.5), dpi=120)
+    hips = [("q4", "right rear hip $q_4$", "-"), ("q6", "right fore hip $q_6$", "--"),
+            ("q8", "left rear hip $q_8$", "-."), ("q10", "left fore hip $q_{10}$", ":")]
+    tmin = max(0.0, min(r["push_time_s"] for r in report["controllers"].values()) - 1.5)
+    for col, c in enumerate(args.controllers[:2]):
+        ax = axes[0][col]
+        q = traces[c]["q"]
+        for key, label, ls in hips:
+            ax.plot(q["time_s"], q[key], ls, lw=1.1, label=label)
+        r = report["controllers"][c]
+        ax.set_title(f"(a) hip joint angles, {CONTROLLER_NAMES.get(c, c)}: "
+                     f"{'recovered' if r['recovered'] else ('FELL' if r['fell'] else 'not recovered')}",
+                     color="black" if r["recovered"] else "tab:red", fontsize=10)
+        ax.set_ylabel("angle [rad]")
+        ax.set_xlabel("time [s]")
+        ax.legend(fontsize=7, loc="upper left", ncol=2)
+    # (a') LTI of both legs, both controllers
+    ax = axes[0][2]
+    for c in args.controllers:
+        l = traces[c]["lti"]
+        ax.plot(l["time_s"], l["lti_right"], "-", color=COLORS.get(c), lw=1, label=f"{c} right")
+        ax.plot(l["time_s"], l["lti_left"], "--", color=COLORS.get(c), lw=1, label=f"{c} left")
+    ax.axhline(0.7, color="k", lw=0.6, ls=":")
+    ax.axhline(0.02, color="tab:red", lw=0.6, ls=":")
+    ax.set_title("leg LTI (MFT space: LTI ≥ 0.7; singular < 0.02)", fontsize=10)
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=7)
+    panels = [("z", "base height [m]", traces, "q"), ("pitch", "pitch [rad]", traces, "q"),
+              ("xd", "forward speed [m/s]", traces, "qd")]
+    for col, (key, label, _, src) in enumerate(panels):
+        ax = axes[1][col]
+        for c in args.controllers:
+            d = traces[c][src]
+            ax.plot(d["time_s"], d[key], color=COLORS.get(c), lw=1.2, label=CONTROLLER_NAMES.get(c, c))
+            r = report["controllers"][c]
+            if r["fell"]:
+                ax.plot([d["time_s"][-1]], [d[key][-1]], "x", color="tab:red", ms=9, mew=2)
+        if key == "z":
+            ax.axhline(args.height, color="k", lw=0.6, ls=":", label="reference")
+            ax.axhline(setup.fall_base_height_m, color="tab:red", lw=0.6, ls=":", label="fall")
+        ax.set_title(f"(b) floating base: {label}", fontsize=10)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7)
+    for row in axes:
+        for ax in row:
+            for c, r in report["controllers"].items():
+                ax.axvline(r["push_time_s"], color=COLORS.get(c), lw=0.8, ls="--", alpha=0.7)
+            ax.set_xlim(left=tmin)
+            ax.grid(alpha=0.3)
+    fig.suptitle(f"Push recovery, $z_B^{{ref}}$ = {args.height:.2f} m, I = {args.impulse:g} N s {setup.direction} "
+                 f"at a {setup.liftoff}-foot lift-off (dashed: push; x: fall)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path

@@ -1,0 +1,295 @@
+#!/usr/bin/env python3
+"""The stack on three hosts (docs/distributed.md): Linux network namespaces made by the test (testnet.py) on a
+private subnet 10.77.<domain>.0/24, joined by veths through a bridge in a switch namespace; the simulator on
+`robot`, the WBC on `ctrl`, estimator, planner and recorder on `aux`, started through
+`mft-supervisor --stack`. Faults on the veth links: nftables random loss, tc tbf, link down.
+
+  - lockstep, initial peers: steps in place 10 s without falling, every service answers every tick, the
+    recorder writes every tick it received;
+  - realtime with 1 % random loss on every link: keeps stepping, the simulator reports the lost commands;
+  - realtime, the WBC host's link cut for 200 ms: the simulator damps within 5 ms of the missed deadline for
+    about the cut, recovers when the link returns, the recorder loses nothing it received;
+  - lockstep through a Fast DDS discovery server (supervised by mft-supervisor on aux);
+  - a tbf rate limit on the robot's link below the stack's bandwidth: what happens (measured and reported).
+
+Skipped with a clear message where network namespaces cannot be made (not root, no CAP_SYS_ADMIN, no ip/nft/tc).
+DDS domains 230-232; each test runs in namespaces of its own (deleted in tearDown even on failure, every
+process stopped by pid through the supervisor's `down` or by its run's end)."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from testnet import TestNet, netns_permitted  # noqa: E402
+
+REPO = Path(__file__).resolve().parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+SCENARIOS = REPO / "config" / "scenarios"
+HOSTS = ["robot", "ctrl", "aux"]
+PLACEMENT = {"mft-sim": "robot", "mft-wbc": "ctrl", "mft-estimator": "aux", "mft-planner": "aux", "mft-record": "aux"}
+CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
+PERMITTED, WHY_NOT = netns_permitted()
+# Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/distributed.md):
+# the cut test stands (0.40 m), as the fault tests do (docs/faults.md).
+CUT_SCENARIO = "stand.yaml"
+STAND_HEIGHT_M = 0.40
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+@unittest.skipUnless(PERMITTED, f"distributed tests skipped: network namespaces are not permitted here ({WHY_NOT}); "
+                                "they need root with CAP_SYS_ADMIN, iproute2, nftables and tc")
+class DistributedTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = Path(tempfile.mkdtemp(prefix="mft-distributed-test-"))
+        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
+        self.nets, self.up_domains, self.procs = [], [], []
+
+    def tearDown(self):
+        for d in self.up_domains:  # a background stack left by a failed test
+            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
+                           capture_output=True, timeout=90)
+        for p in self.procs:
+            if p.poll() is None:
+                p.terminate()  # the supervisor stops its children (and they die with it: PDEATHSIG)
+                try:
+                    p.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+        for net in self.nets:
+            net.destroy()
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    # ------------------------------------------------------------------------------------------ helpers
+    def network(self, domain, discovery="initial_peers"):
+        net = TestNet.for_test(f"d{domain}", HOSTS, domain)
+        self.nets.append(net)
+        net.create()
+        stack = self.tmp / f"stack-{domain}.yaml"
+        stack.write_text(net.stack_yaml(PLACEMENT, discovery, server_host="aux"))
+        return net, stack
+
+    def scenario(self, name, duration_s=None):
+        if duration_s is None:
+            return SCENARIOS / name
+        text = (SCENARIOS / name).read_text()
+        self.assertIn("duration_s: 10.0", text)
+        path = self.tmp / name.replace(".yaml", f"-{duration_s:g}s.yaml")
+        path.write_text(text.replace("duration_s: 10.0", f"duration_s: {duration_s}"))
+        return path
+
+    def sup_cmd(self, *args):
+        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
+        if args[0] in ("run", "up"):
+            cmd += ["--bin-dir", str(BIN)]
+        return cmd
+
+    def run_start(self, scenario, domain, stack, *extra):
+        """Starts `mft-supervisor run --json` in the background; returns (process, run folder)."""
+        run_dir = self.tmp / f"run-{domain}"
+        p = subprocess.Popen(self.sup_cmd("run", scenario, "--domain", domain, "--stack", stack, "--json",
+                                          "--run-dir", run_dir, *extra),
+                             env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        return p, run_dir
+
+    def run_finish(self, p, timeout=240):
+        out, err = p.communicate(timeout=timeout)
+        try:
+            s = json.loads(out)
+        except ValueError:
+            self.fail(f"no JSON summary (exit {p.returncode}): {err[-3000:]}")
+        return p.returncode, s, err
+
+    def wait_for_line(self, path, text, timeout=60):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if path.exists() and text in path.read_text(errors="replace"):
+                return
+            time.sleep(0.02)
+        self.fail(f"'{text}' not in {path} within {timeout} s")
+
+    def up(self, scenario, domain, stack, *extra):
+        self.up_domains.append(domain)
+        p = subprocess.run(self.sup_cmd("up", scenario, "--domain", domain, "--stack", stack, *extra), env=self.env,
+                           capture_output=True, text=True, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr[-3000:])
+        st = subprocess.run(self.sup_cmd("status", "--domain", domain, "--json"), env=self.env, capture_output=True,
+                            text=True, timeout=30)
+        return json.loads(st.stdout)
+
+    def down(self, domain, status):
+        p = subprocess.run(self.sup_cmd("down", "--domain", domain), env=self.env, capture_output=True, text=True,
+                           timeout=90)
+        self.up_domains.remove(domain)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        run_dir = Path(status["run_dir"])
+        return {n: json.loads((run_dir / f"{n}.summary.json").read_text()) for n in PLACEMENT
+                if (run_dir / f"{n}.summary.json").exists() or n != "mft-record"}
+
+    def check_recorder_kept_what_it_received(self, rec, record_file):
+        """Every sample the recorder received is in the file once: received = written + repeated (a re-sent
+        tick is written once), nothing dropped, no error, and the rawlog holds exactly `written` ticks."""
+        self.assertEqual(rec.get("error", ""), "", rec.get("error"))
+        for topic in CHAIN_TOPICS:
+            t = rec["topics"][topic]
+            self.assertEqual(t["dropped_queue"], 0, (topic, t))
+            self.assertEqual(t["received"], t["written"] + t["repeated"], (topic, t))
+        info = json.loads(subprocess.run([str(BIN / "mft-export"), str(record_file), "--info", "--json"],
+                                         capture_output=True, text=True, timeout=120).stdout)
+        for label, topic in (("gt_q", "GroundTruth"), ("joint_q", "SensorData"), ("est_q", "RobotState"),
+                             ("plan_ref", "Reference"), ("joint_tau_cmd", "JointCommand"), ("wbc_diag", "WbcDiagnostics")):
+            self.assertEqual(info["labels"][label]["count"], rec["topics"][topic]["written"], (label, topic))
+        return {t: (rec["topics"][t]["written"], rec["topics"][t]["tick_gaps"]) for t in CHAIN_TOPICS}
+
+    @staticmethod
+    def link_rates(before, after, seconds):
+        """kB/s sent and received by each host over its link."""
+        return {h: {"tx_kBps": round((after[h]["tx_bytes"] - before[h]["tx_bytes"]) / seconds / 1e3, 1),
+                    "rx_kBps": round((after[h]["rx_bytes"] - before[h]["rx_bytes"]) / seconds / 1e3, 1)}
+                for h in before}
+
+    # -------------------------------------------------------------------------------------------- tests
+    def test_1_lockstep_three_hosts_steps_in_place(self):
+        domain = 230
+        net, stack = self.network(domain)
+        record = self.tmp / "lockstep.rawlog"
+        before = {h: net.counters(h) for h in HOSTS}
+        t0 = time.monotonic()
+        p, run_dir = self.run_start(self.scenario("step-in-place.yaml"), domain, stack, "--record", record)
+        code, s, err = self.run_finish(p)
+        wall = time.monotonic() - t0
+        after = {h: net.counters(h) for h in HOSTS}
+        self.assertEqual(code, 0, err[-3000:])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], 10000)
+        for name in ("mft-estimator", "mft-planner", "mft-wbc"):
+            self.assertEqual(s["services"][name]["ticks"], 10000, name)      # every tick answered once
+            self.assertEqual(s["services"][name]["last_tick"], 9999, name)
+        self.assertGreater(sim["touchdowns"][0], 5)                           # it really steps
+        self.assertEqual(s["stack"]["discovery"], "initial_peers")
+        self.assertEqual(s["stack"]["services"]["mft-wbc"], "ctrl")
+        kept = self.check_recorder_kept_what_it_received(s["services"]["mft-record"], record)
+        # The traffic really crossed the links: the simulator's samples left robot, the commands left ctrl.
+        self.assertGreater(after["robot"]["tx_bytes"] - before["robot"]["tx_bytes"], 5e6)
+        self.assertGreater(after["ctrl"]["tx_bytes"] - before["ctrl"]["tx_bytes"], 2e6)
+        per_tick = {h: round((after[h]["tx_bytes"] - before[h]["tx_bytes"]) / 10000) for h in HOSTS}
+        log(f"\nlockstep on three hosts: no fall, 10000 ticks answered by every service, sim wall "
+            f"{sim['wall_time_s']:.2f} s ({sim['real_time_factor']:.2f}x real time), {sim['lockstep_resends']} re-sends, "
+            f"whole run {wall:.1f} s; recorder (written, tick gaps) {kept}; bytes sent per tick {per_tick}")
+
+    def test_2_realtime_one_percent_loss_keeps_stepping(self):
+        domain = 231
+        net, stack = self.network(domain)
+        record = self.tmp / "loss.rawlog"
+        p, run_dir = self.run_start(self.scenario("step-in-place.yaml"), domain, stack, "--mode", "realtime",
+                                    "--record", record)
+        self.wait_for_line(run_dir / "mft-sim.log", "READY mft-sim")
+        for h in HOSTS:
+            net.set_loss(h, 1)
+        code, s, err = self.run_finish(p)
+        drops = {h: net.loss_counters(h) for h in HOSTS}
+        self.assertEqual(code, 0, err[-3000:])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], 10000)
+        self.assertGreater(sum(d[0] for d in drops.values()), 100, drops)      # the loss was there
+        self.assertGreater(sim["lost_commands"], 0, sim)                       # and the simulator saw it
+        kept = self.check_recorder_kept_what_it_received(s["services"]["mft-record"], record)
+        lat = sim["latency_us"]
+        wbc = s["services"]["mft-wbc"]
+        log(f"\n1 % loss on every link, realtime 10 s: no fall; packets dropped (dropped, passed) per host {drops}; "
+            f"simulator: lost commands {sim['lost_commands']} ({sim['lost_commands'] / 10:.1f}/s), deadline misses "
+            f"{sim['deadline_misses']} ({sim['deadline_misses'] / 10:.1f}/s), DDS reader deadline misses "
+            f"{sim['reader_deadline_misses']}, damping ticks {sim['damping_ticks']}, commands received "
+            f"{sim['commands_received']}; WBC answered {wbc['ticks']} ticks; latency p50 {lat['p50']:.0f} us p99 "
+            f"{lat['p99']:.0f} us max {lat['max']:.0f} us; recorder (written, tick gaps) {kept}")
+
+    def test_3_cut_of_the_wbc_link_damps_and_recovers(self):
+        domain = 232
+        net, stack = self.network(domain)
+        record = self.tmp / "cut.rawlog"
+        st = self.up(self.scenario(CUT_SCENARIO), domain, stack, "--mode", "realtime", "--record", record)
+        time.sleep(3.0)
+        cut_lo, cut_hi = net.cut("ctrl", 0.2)
+        time.sleep(2.5)
+        s = self.down(domain, st)
+        sim, rec = s["mft-sim"], s["mft-record"]
+        onset, late_ms, duration_ms = max(sim["damping_episodes"], key=lambda e: e[2])
+        self.assertGreater(duration_ms, 150.0, sim["damping_episodes"])      # the cut, not a stray late command
+        self.assertLess(duration_ms, 600.0, sim["damping_episodes"])         # commands came back after it
+        self.assertLessEqual(late_ms, 5.0, sim["damping_episodes"])          # damping <= 5 ms after the deadline
+        self.assertGreaterEqual(sim["watchdog_recoveries"], 1)
+        kept = self.check_recorder_kept_what_it_received(rec, record)
+        # No command from the last one before the cut to the first one after it: the deadline (3 ms), the
+        # detection delay and the damping episode. Compared with the cut, what is left is how long the stack
+        # took to answer again once the link was back (within the precision of the ip commands' timing).
+        silent_ms = 3.0 + late_ms + duration_ms
+        log(f"\n{CUT_SCENARIO}: ctrl link down {cut_lo * 1e3:.0f}-{cut_hi * 1e3:.0f} ms: damping {late_ms:.2f} ms after "
+            f"the 3 ms deadline, for {duration_ms:.0f} ms (no command for {silent_ms:.0f} ms: recovery "
+            f"{silent_ms - cut_hi * 1e3:+.0f} to {silent_ms - cut_lo * 1e3:+.0f} ms after the link); watchdog recoveries "
+            f"{sim['watchdog_recoveries']}; fall criterion hit {sim['fell']} {sim.get('fall_reason', '')} at "
+            f"{sim['fall_time_s']:.3f} s, largest sag {sim['base_height_error_m']['max'] * 100:.1f} cm, final base height "
+            f"{sim['final_base_height_m']:.3f} m; all episodes "
+            f"{sim['damping_episodes']}; recorder (written, tick gaps) {kept}")
+        # 200 ms of damping let the base sink ~15 cm: past the fall threshold (base below 0.25 m) on most runs,
+        # which a `run` would end with a fall. The long-running stack goes on (--continue-after-fall) and the
+        # WBC stands the robot back up once its commands return: that is the recovery asserted here.
+        self.assertLess(abs(sim["final_base_height_m"] - STAND_HEIGHT_M), 0.01, sim["final_base_height_m"])
+
+    def test_4_discovery_server_lockstep(self):
+        domain = 230
+        net, stack = self.network(domain, discovery="server")
+        p, run_dir = self.run_start(self.scenario("step-in-place.yaml", 5.0), domain, stack)
+        code, s, err = self.run_finish(p)
+        self.assertEqual(code, 0, err[-3000:])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], 5000)
+        for name in ("mft-estimator", "mft-planner", "mft-wbc"):
+            self.assertEqual(s["services"][name]["ticks"], 5000, name)
+        self.assertEqual(s["stack"]["discovery"], "server")
+        self.assertEqual(s["stack"]["services"]["discovery-server"], "aux")
+        self.assertIn("### Server is running ###", (run_dir / "discovery-server.log").read_text())
+        self.assertIn("<discoveryProtocol>CLIENT</discoveryProtocol>", (run_dir / "dds-robot.xml").read_text())
+        log(f"\ndiscovery server on aux, lockstep 5 s: no fall, 5000 ticks answered by every service, sim wall "
+            f"{sim['wall_time_s']:.2f} s, {sim['lockstep_resends']} re-sends")
+
+    def test_5_rate_limit_below_the_stack_bandwidth(self):
+        domain = 231
+        net, stack = self.network(domain)
+        st = self.up(self.scenario("stand.yaml"), domain, stack, "--mode", "realtime")
+        time.sleep(1.5)
+        b0 = {h: net.counters(h) for h in HOSTS}
+        time.sleep(2.0)
+        b1 = {h: net.counters(h) for h in HOSTS}
+        rates = self.link_rates(b0, b1, 2.0)
+        need_kbit = rates["robot"]["tx_kBps"] * 8
+        limit_kbit = int(need_kbit * 0.5)  # half of what the simulator sends
+        net.set_rate("robot", f"{limit_kbit}kbit", burst="16kb", latency="5ms")
+        time.sleep(1.0)
+        limited = net.rate_stats("robot")
+        net.clear_rate("robot")
+        time.sleep(2.0)
+        s = self.down(domain, st)
+        sim = s["mft-sim"]
+        log(f"\nlink rates (kB/s) {rates}; tbf {limit_kbit} kbit/s on robot for 1 s: {limited}; simulator: deadline "
+            f"misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, episodes {sim['damping_episodes']}, "
+            f"fell {sim['fell']} {sim.get('fall_reason', '')}")
+        self.assertGreater(limited["dropped"], 0, limited)               # the limit bit
+        self.assertGreaterEqual(sim["deadline_misses"], 1, sim)          # and the simulator noticed
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -26,7 +26,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from testnet import TestNet, netns_permitted  # noqa: E402
+from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
@@ -150,7 +150,8 @@ class DistributedTest(unittest.TestCase):
         for label, topic in (("gt_q", "GroundTruth"), ("joint_q", "SensorData"), ("est_q", "RobotState"),
                              ("plan_ref", "Reference"), ("joint_tau_cmd", "JointCommand"), ("wbc_diag", "WbcDiagnostics")):
             self.assertEqual(info["labels"][label]["count"], rec["topics"][topic]["written"], (label, topic))
-        return {t: (rec["topics"][t]["written"], rec["topics"][t]["tick_gaps"]) for t in CHAIN_TOPICS}
+        return {t: (rec["topics"][t]["first"], rec["topics"][t]["written"], rec["topics"][t]["tick_gaps"])
+                for t in CHAIN_TOPICS}
 
     @staticmethod
     def link_rates(before, after, seconds):
@@ -187,7 +188,7 @@ class DistributedTest(unittest.TestCase):
         per_tick = {h: round((after[h]["tx_bytes"] - before[h]["tx_bytes"]) / 10000) for h in HOSTS}
         log(f"\nlockstep on three hosts: no fall, 10000 ticks answered by every service, sim wall "
             f"{sim['wall_time_s']:.2f} s ({sim['real_time_factor']:.2f}x real time), {sim['lockstep_resends']} re-sends, "
-            f"whole run {wall:.1f} s; recorder (written, tick gaps) {kept}; bytes sent per tick {per_tick}")
+            f"whole run {wall:.1f} s; recorder (first tick, written, tick gaps) {kept}; bytes sent per tick {per_tick}")
 
     def test_2_realtime_one_percent_loss_keeps_stepping(self):
         domain = 231
@@ -196,8 +197,9 @@ class DistributedTest(unittest.TestCase):
         p, run_dir = self.run_start(self.scenario("step-in-place.yaml"), domain, stack, "--mode", "realtime",
                                     "--record", record)
         self.wait_for_line(run_dir / "mft-sim.log", "READY mft-sim")
-        for h in HOSTS:
-            net.set_loss(h, 1)
+        with realtime_priority():
+            for h in HOSTS:
+                net.set_loss(h, 1)
         code, s, err = self.run_finish(p)
         drops = {h: net.loss_counters(h) for h in HOSTS}
         self.assertEqual(code, 0, err[-3000:])
@@ -214,7 +216,7 @@ class DistributedTest(unittest.TestCase):
             f"{sim['deadline_misses']} ({sim['deadline_misses'] / 10:.1f}/s), DDS reader deadline misses "
             f"{sim['reader_deadline_misses']}, damping ticks {sim['damping_ticks']}, commands received "
             f"{sim['commands_received']}; WBC answered {wbc['ticks']} ticks; latency p50 {lat['p50']:.0f} us p99 "
-            f"{lat['p99']:.0f} us max {lat['max']:.0f} us; recorder (written, tick gaps) {kept}")
+            f"{lat['p99']:.0f} us max {lat['max']:.0f} us; recorder (first tick, written, tick gaps) {kept}")
 
     def test_3_cut_of_the_wbc_link_damps_and_recovers(self):
         domain = 232
@@ -242,7 +244,7 @@ class DistributedTest(unittest.TestCase):
             f"{sim['watchdog_recoveries']}; fall criterion hit {sim['fell']} {sim.get('fall_reason', '')} at "
             f"{sim['fall_time_s']:.3f} s, largest sag {sim['base_height_error_m']['max'] * 100:.1f} cm, final base height "
             f"{sim['final_base_height_m']:.3f} m; all episodes "
-            f"{sim['damping_episodes']}; recorder (written, tick gaps) {kept}")
+            f"{sim['damping_episodes']}; recorder (first tick, written, tick gaps) {kept}")
         # 200 ms of damping let the base sink ~15 cm: past the fall threshold (base below 0.25 m) on most runs,
         # which a `run` would end with a fall. The long-running stack goes on (--continue-after-fall) and the
         # WBC stands the robot back up once its commands return: that is the recovery asserted here.
@@ -277,10 +279,11 @@ class DistributedTest(unittest.TestCase):
         rates = self.link_rates(b0, b1, 2.0)
         need_kbit = rates["robot"]["tx_kBps"] * 8
         limit_kbit = int(need_kbit * 0.5)  # half of what the simulator sends
-        net.set_rate("robot", f"{limit_kbit}kbit", burst="16kb", latency="5ms")
-        time.sleep(1.0)
-        limited = net.rate_stats("robot")
-        net.clear_rate("robot")
+        with realtime_priority():
+            net.set_rate("robot", f"{limit_kbit}kbit", burst="16kb", latency="5ms")
+            time.sleep(1.0)
+            limited = net.rate_stats("robot")
+            net.clear_rate("robot")
         time.sleep(2.0)
         s = self.down(domain, st)
         sim = s["mft-sim"]
@@ -289,6 +292,8 @@ class DistributedTest(unittest.TestCase):
             f"fell {sim['fell']} {sim.get('fall_reason', '')}")
         self.assertGreater(limited["dropped"], 0, limited)               # the limit bit
         self.assertGreaterEqual(sim["deadline_misses"], 1, sim)          # and the simulator noticed
+        onset, _, duration_ms = sim["damping_episodes"][-1]              # commands flowed again at the end
+        self.assertLess(onset + duration_ms * 1e-3, sim["sim_time_s"] - 0.5, sim["damping_episodes"])
 
 
 if __name__ == "__main__":

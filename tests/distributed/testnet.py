@@ -69,6 +69,31 @@ def netns_permitted(probe_name=None):
     return True, ""
 
 
+class realtime_priority:
+    """Runs a block (and the commands it starts) at SCHED_FIFO `priority` where permitted: a realtime stack
+    under test runs at SCHED_FIFO 80 and delays an `ip`/`tc`/`nft` at normal priority by tens of ms (once
+    1.2 s) on 2 busy cores, so a fault would start and end late."""
+
+    def __init__(self, priority=85):
+        self.priority = priority
+        self.saved = None
+
+    def __enter__(self):
+        try:
+            self.saved = (os.sched_getscheduler(0), os.sched_getparam(0))
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))
+        except (OSError, AttributeError):
+            self.saved = None
+        return self
+
+    def __exit__(self, *exc):
+        if self.saved:
+            try:
+                os.sched_setscheduler(0, *self.saved)
+            except OSError:
+                pass
+
+
 class TestNet:
     """hosts: {host name: (namespace name, IPv4 address)}, all on one /`prefix_len` subnet."""
 
@@ -201,17 +226,11 @@ class TestNet:
     def link(self, host, up):
         _run(["ip", "-n", self.ns(host), "link", "set", IFACE, "up" if up else "down"])
 
-    def cut(self, host, seconds, rt_priority=85):
+    def cut(self, host, seconds):
         """Takes `host`'s link down for `seconds`. Returns (shortest, longest) time it can have been down [s]:
         from after `ip link set down` returned to before `up` was issued, and from before the first to after
-        the second command. A realtime stack under test runs at SCHED_FIFO 80 and would delay these commands
-        by tens of ms on 2 busy cores: the cut runs at SCHED_FIFO `rt_priority` (where permitted)."""
-        old_policy, old_param = os.sched_getscheduler(0), os.sched_getparam(0)
-        try:
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(rt_priority))
-        except (OSError, AttributeError):
-            pass
-        try:
+        the second command."""
+        with realtime_priority():
             t0 = time.monotonic()
             self.link(host, False)
             t1 = time.monotonic()
@@ -221,11 +240,6 @@ class TestNet:
                 t2 = time.monotonic()
                 self.link(host, True)
                 t3 = time.monotonic()
-        finally:
-            try:
-                os.sched_setscheduler(0, old_policy, old_param)
-            except OSError:
-                pass
         return t2 - t1, t3 - t0
 
     def clear(self, host):

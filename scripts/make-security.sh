@@ -9,7 +9,7 @@
 # Per identity: <name>.pem (certificate), <name>.key (private key, mode 600), permissions_<name>.p7s;
 # shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/security.md).
 # Permissions: each service may publish only its own topics; only the sim publishes SensorData/GroundTruth,
-# only the WBC JointCommand; the recorder subscribes to every topic and publishes nothing; cmd publishes
+# only the WBC JointCommand; the recorder subscribes to every topic and publishes only its RecorderProgress (lockstep flow control); cmd publishes
 # OperatorCommand and Disturbance only.
 set -euo pipefail
 
@@ -71,11 +71,11 @@ declare -A PUB=(
   [estimator]="RobotState"
   [planner]="Reference"
   [wbc]="JointCommand WbcDiagnostics"
-  [record]=""
+  [record]="RecorderProgress"
   [cmd]="OperatorCommand Disturbance"
 )
 declare -A SUB=(
-  [sim]="JointCommand Disturbance"
+  [sim]="JointCommand Disturbance RecorderProgress"
   [estimator]="SensorData GroundTruth"
   [planner]="RobotState OperatorCommand"
   [wbc]="RobotState Reference"

@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -15,8 +16,11 @@
 #include <fstream>
 #include <sstream>
 #include <thread>
+#include <type_traits>
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
@@ -164,10 +168,36 @@ class RecorderParticipant {
   dds::DomainParticipant* get() const { return participant_; }
   dds::Subscriber* subscriber() const { return subscriber_; }
 
+  // Lockstep flow control: tells the simulator how far the recorder has read.
+  void enableProgress() {
+    dds::TypeSupport type(new msg::RecorderProgressPubSubType());
+    type.register_type(participant_);
+    auto* topic = participant_->create_topic("RecorderProgress", type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    if (!topic || !publisher_) throw services::DdsError("cannot create the RecorderProgress topic");
+    progress_writer_ = publisher_->create_datawriter_with_profile(topic, "lockstep_writer");  // best effort: re-sent every 50 ms at worst
+    if (!progress_writer_) throw services::DdsError("cannot create a writer on RecorderProgress (permissions?)");
+  }
+  void publishProgress(std::uint64_t tick, std::uint64_t all_topics_tick, std::uint64_t received) {
+    if (!progress_writer_) return;
+    progress_.tick(tick);
+    progress_.all_topics_tick(all_topics_tick);
+    progress_.received(received);
+    progress_writer_->write(&progress_);
+  }
+
  private:
   dds::DomainParticipant* participant_ = nullptr;
   dds::Subscriber* subscriber_ = nullptr;
+  dds::Publisher* publisher_ = nullptr;
+  dds::DataWriter* progress_writer_ = nullptr;
+  msg::RecorderProgress progress_;
 };
+
+template <class M, class = void>
+struct HasTick : std::false_type {};
+template <class M>
+struct HasTick<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
 
 // One topic into the recorder: the DDS receive thread copies each sample into the recorder's queue.
 template <class Msg, class PubSubType>
@@ -194,9 +224,12 @@ class Subscription : public dds::DataReaderListener {
       if (info.valid_data) {
         recorder_.push(rawlog::Message(sample_));
         received_.fetch_add(1, std::memory_order_relaxed);
+        if constexpr (HasTick<Msg>::value)
+          if (sample_.tick() > last_tick_.load(std::memory_order_relaxed)) last_tick_.store(sample_.tick(), std::memory_order_relaxed);
       }
   }
   std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
+  std::uint64_t lastTick() const { return last_tick_.load(std::memory_order_relaxed); }
 
  private:
   dds::Subscriber* subscriber_;
@@ -205,6 +238,7 @@ class Subscription : public dds::DataReaderListener {
   dds::DataReader* reader_ = nullptr;
   Msg sample_;
   std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> last_tick_{0};
 };
 
 }  // namespace
@@ -311,18 +345,44 @@ int main(int argc, char** argv) {
     Subscription<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> r5(p, "WbcDiagnostics", chain, recorder, be);
     Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> r6(p, "OperatorCommand", "event_reader", recorder);
     Subscription<msg::Disturbance, msg::DisturbancePubSubType> r7(p, "Disturbance", "event_reader", recorder);
+    if (lockstep) {
+      try {
+        p.enableProgress();
+      } catch (const services::DdsError& e) {
+        cli.fail(e.what());
+      }
+    }
+    // Lockstep: publish how far the recorder has read its socket (the simulator waits when this falls more
+    // than its --recorder-window behind). From this 5 ms loop, not per sample: no cost per tick.
+    std::uint64_t progress_sent = 0, progress_all_sent = 0;
+    int progress_idle_loops = 0;
+    auto flowing = [&] { return r0.received() && r1.received() && r2.received() && r3.received() && r4.received() && r5.received(); };
+    auto publishProgress = [&] {
+      // Nothing until every 1 kHz topic flows: the simulator holds tick 0 until then, so that no writer's
+      // first samples go out before it has matched the recorder (DDS.md G13).
+      if (!lockstep || !flowing()) return;
+      // The newest tick seen on any topic: the socket is a FIFO, so everything sent before it has been taken
+      // in (or was lost, and waiting for it would deadlock the run).
+      const std::uint64_t tick = std::max({r0.lastTick(), r1.lastTick(), r2.lastTick(), r3.lastTick(), r4.lastTick(), r5.lastTick()});
+      const std::uint64_t all = std::min({r0.lastTick(), r1.lastTick(), r2.lastTick(), r3.lastTick(), r4.lastTick(), r5.lastTick()});
+      if (tick == progress_sent && all == progress_all_sent && ++progress_idle_loops < 10) return;  // repeat every 50 ms
+      progress_idle_loops = 0;
+      progress_sent = tick;
+      progress_all_sent = all;
+      p.publishProgress(tick, all, r0.received() + r1.received() + r2.received() + r3.received() + r4.received() + r5.received());
+    };
     services::announceReady("mft-record");
     // Recording must not slow the stack: once every 1 kHz topic flows (discovery done at full priority, so
     // the first ticks are not missed), the DDS threads drop to --nice and the stack gets the CPU first on a
     // busy machine; the recorder catches up from its socket buffers. The writer thread stays at nice 0.
     bool reniced = nice_value == 0;
-    auto flowing = [&] { return r0.received() && r1.received() && r2.received() && r3.received() && r4.received() && r5.received(); };
     // The last half second of the scenario runs at full priority again: when the simulator exits, its
     // participant's goodbye (another socket, another thread) unmatches its writers, and samples of the last
     // ticks still waiting in a niced recorder's socket buffer would be discarded.
     const auto end_ns = static_cast<std::uint64_t>(std::max(0.0, scenario.duration_s - 0.5) * 1e9);
     bool near_end = false;
     while (!services::shutdownRequested()) {
+      publishProgress();
       if (!reniced && flowing()) {
         reniceThreads(nice_value, recorder.writerThreadId());
         reniced = true;

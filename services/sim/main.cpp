@@ -10,6 +10,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -82,6 +83,8 @@ int main(int argc, char** argv) {
   cli.option("start-timeout", "seconds to wait for the controller chain to connect and answer", "30");
   cli.option("watchdog-ms", "realtime: command timeout before the actuators damp [ms]", "3");
   cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
+  cli.option("recorder-window", "lockstep: never run more than this many ticks ahead of mft-record's progress "
+                                "(0 = no recorder flow control; the supervisor sets it when recording)", "0");
   cli.flag("quiet", "no progress lines");
   cli.parse(argc, argv);
   services::installShutdownHandlers();
@@ -184,6 +187,21 @@ int main(int argc, char** argv) {
         std::lock_guard<std::mutex> lock(mutex);
         pending_pushes.push_back(spec);
       });
+  // Lockstep recording: a starved recorder must slow the simulator down, not lose samples in its socket buffer.
+  const auto recorder_window = static_cast<std::uint64_t>(cli.getInt("recorder-window", 0, 1000000));
+  std::uint64_t recorder_tick = 0, recorder_all_tick = 0, recorder_waits = 0;
+  bool recorder_heard = false;  // the recorder receives every 1 kHz topic
+  double recorder_wait_s = 0.0;
+  std::unique_ptr<services::TopicReader<msg::RecorderProgress, msg::RecorderProgressPubSubType>> progress_reader;
+  if (recorder_window > 0 && ctx.lockstep())
+    progress_reader = std::make_unique<services::TopicReader<msg::RecorderProgress, msg::RecorderProgressPubSubType>>(
+        ctx.participant(), "RecorderProgress", "lockstep_reader", [&](const msg::RecorderProgress& m) {
+          std::lock_guard<std::mutex> lock(mutex);
+          recorder_heard = true;
+          recorder_tick = std::max(recorder_tick, m.tick());
+          recorder_all_tick = std::max(recorder_all_tick, m.all_topics_tick());
+          arrived.notify_all();
+        });
   services::announceReady("mft-sim");
 
   msg::SensorData sensor_msg;
@@ -242,6 +260,25 @@ int main(int argc, char** argv) {
 
   while (!services::shutdownRequested() && (forever || simulator.tick() < ticks_total)) {
     const std::uint64_t k = simulator.tick();
+    if (progress_reader) {
+      std::unique_lock<std::mutex> lock(mutex);
+      if (k > recorder_tick + recorder_window) {
+        ++recorder_waits;
+        const auto t0 = Clock::now();
+        const auto deadline = t0 + std::chrono::duration<double>(command_timeout_s);
+        while (k > recorder_tick + recorder_window && !services::shutdownRequested() && Clock::now() < deadline)
+          arrived.wait_for(lock, std::chrono::milliseconds(10));
+        recorder_wait_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        if (k > recorder_tick + recorder_window && !services::shutdownRequested()) {
+          char buf[200];
+          std::snprintf(buf, sizeof buf, "timeout: mft-record confirmed only tick %llu of %llu within %.1f s (is it running?)",
+                        static_cast<unsigned long long>(recorder_tick), static_cast<unsigned long long>(k), command_timeout_s);
+          error = buf;
+          exit_code = 3;
+          break;
+        }
+      }
+    }
     publish();
     model::ActuatorCommand command;
     if (ctx.lockstep()) {
@@ -250,7 +287,9 @@ int main(int argc, char** argv) {
       // lost (DDS.md G13), and every service answers a repeated tick with its cached answer.
       std::unique_lock<std::mutex> lock(mutex);
       const auto deadline = Clock::now() + std::chrono::duration<double>(k == 0 ? start_timeout_s : command_timeout_s);
-      while (!(have_command && latest.tick == k) && !services::shutdownRequested()) {
+      // Tick 0 of a recorded run is held (and re-sent) until the recorder receives every topic.
+      const auto answered = [&] { return have_command && latest.tick == k && (k > 0 || !progress_reader || recorder_heard); };
+      while (!answered() && !services::shutdownRequested()) {
         if (Clock::now() > deadline) break;
         if (arrived.wait_for(lock, std::chrono::milliseconds(k == 0 ? 100 : resend_ms)) == std::cv_status::timeout) {
           lock.unlock();
@@ -260,10 +299,14 @@ int main(int argc, char** argv) {
         }
       }
       if (services::shutdownRequested()) break;
-      if (!(have_command && latest.tick == k)) {
+      if (!answered()) {
         char buf[200];
-        std::snprintf(buf, sizeof buf, "timeout: no JointCommand for tick %llu within %.1f s (is mft-wbc running?)",
-                      static_cast<unsigned long long>(k), k == 0 ? start_timeout_s : command_timeout_s);
+        if (have_command && latest.tick == k)
+          std::snprintf(buf, sizeof buf, "timeout: mft-record did not receive every topic within %.1f s (is it running?)",
+                        start_timeout_s);
+        else
+          std::snprintf(buf, sizeof buf, "timeout: no JointCommand for tick %llu within %.1f s (is mft-wbc running?)",
+                        static_cast<unsigned long long>(k), k == 0 ? start_timeout_s : command_timeout_s);
         error = buf;
         exit_code = 3;
         break;
@@ -332,10 +375,22 @@ int main(int argc, char** argv) {
     }
   }
   const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
+  // A recorded lockstep run ends once the recorder holds the last tick on every topic (at most 2 s): the
+  // supervisor stops every service when the simulator exits, and samples still waiting in a busy recorder's
+  // socket would be discarded as their writers leave.
+  bool recorder_complete = true;
+  if (progress_reader && simulator.tick() > 0) {
+    const std::uint64_t last = simulator.tick() - 1;
+    std::unique_lock<std::mutex> lock(mutex);
+    const auto deadline = Clock::now() + std::chrono::seconds(2);
+    while (recorder_all_tick < last && !services::shutdownRequested() && Clock::now() < deadline)
+      arrived.wait_for(lock, std::chrono::milliseconds(10));
+    recorder_complete = recorder_all_tick >= last;
+  }
   if (!error.empty()) std::fprintf(stderr, "mft-sim: %s\n", error.c_str());
 
   const auto& stats = simulator.stats();
-  char buf[2000];
+  char buf[3000];
   std::snprintf(
       buf, sizeof buf,
       "{\"service\": \"mft-sim\", \"scenario\": \"%s\", \"mode\": \"%s\", \"fell\": %s, \"fall_time_s\": %.4f, "
@@ -346,7 +401,7 @@ int main(int argc, char** argv) {
       "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
       "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", "
       "\"commands_received\": %llu, \"commands_rejected\": {\"nonfinite\": %llu, \"out_of_range\": %llu, \"bad_mode\": %llu}, "
-      "\"disturbances_rejected\": %llu, ",
+      "\"disturbances_rejected\": %llu, \"recorder_window\": %llu, \"recorder_waits\": %llu, \"recorder_wait_s\": %.3f, \"recorder_complete\": %s, ",
       scenario.name.c_str(), ctx.lockstep() ? "lockstep" : "realtime", monitor.fell() ? "true" : "false",
       monitor.fallTime(), monitor.fallReason().c_str(), static_cast<unsigned long long>(simulator.tick()),
       simulator.time(), wall_s, simulator.time() / std::max(wall_s, 1e-9),
@@ -359,7 +414,9 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(stats.touchdowns[0]), static_cast<unsigned long long>(stats.touchdowns[1]),
       error.c_str(), static_cast<unsigned long long>(commands_received),
       static_cast<unsigned long long>(commands_rejected[1]), static_cast<unsigned long long>(commands_rejected[2]),
-      static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_rejected));
+      static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_rejected),
+      static_cast<unsigned long long>(progress_reader ? recorder_window : 0), static_cast<unsigned long long>(recorder_waits),
+      recorder_wait_s, recorder_complete ? "true" : "false");
   std::string episode_json = "[";
   for (std::size_t i = 0; i < episodes.size(); ++i) {
     char e[96];

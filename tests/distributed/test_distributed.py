@@ -10,6 +10,8 @@ private subnet 10.77.<domain>.0/24, joined by veths through a bridge in a switch
   - realtime, the WBC host's link cut for 200 ms: the simulator damps within 5 ms of the missed deadline for
     about the cut, recovers when the link returns, the recorder loses nothing it received;
   - lockstep through a Fast DDS discovery server (supervised by mft-supervisor on aux);
+  - lockstep with one supervisor per host (`--host`), as on real machines;
+  - lockstep secured with DDS Security (--secure) across the hosts;
   - a tbf rate limit on the robot's link below the stack's bandwidth: what happens (measured and reported).
 
 Skipped with a clear message where network namespaces cannot be made (not root, no CAP_SYS_ADMIN, no ip/nft/tc).
@@ -55,9 +57,10 @@ class DistributedTest(unittest.TestCase):
         self.nets, self.up_domains, self.procs = [], [], []
 
     def tearDown(self):
-        for d in self.up_domains:  # a background stack left by a failed test
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
-                           capture_output=True, timeout=90)
+        for d in self.up_domains:  # a background stack left by a failed test: domain or (domain, host)
+            host = ["--host", d[1]] if isinstance(d, tuple) else []
+            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d[0] if host else d)] + host,
+                           env=self.env, capture_output=True, timeout=90)
         for p in self.procs:
             if p.poll() is None:
                 p.terminate()  # the supervisor stops its children (and they die with it: PDEATHSIG)
@@ -267,6 +270,61 @@ class DistributedTest(unittest.TestCase):
         self.assertIn("<discoveryProtocol>CLIENT</discoveryProtocol>", (run_dir / "dds-robot.xml").read_text())
         log(f"\ndiscovery server on aux, lockstep 5 s: no fall, 5000 ticks answered by every service, sim wall "
             f"{sim['wall_time_s']:.2f} s, {sim['lockstep_resends']} re-sends")
+
+    def test_6_one_supervisor_per_host(self):
+        """As on real machines: each host runs its own supervisor with --host (up on ctrl and aux, run on the
+        simulator's host), all with the same stack file."""
+        domain = 232
+        net, stack = self.network(domain)
+        scenario = self.scenario("step-in-place.yaml", 5.0)
+        status = {}
+        for host in ("aux", "ctrl"):
+            self.up_domains.append((domain, host))
+            p = subprocess.run(self.sup_cmd("up", scenario, "--domain", domain, "--stack", stack, "--host", host),
+                               env=self.env, capture_output=True, text=True, timeout=120)
+            self.assertEqual(p.returncode, 0, p.stderr[-3000:])
+            st = subprocess.run(self.sup_cmd("status", "--domain", domain, "--host", host, "--json"), env=self.env,
+                                capture_output=True, text=True, timeout=30)
+            status[host] = json.loads(st.stdout)
+        self.assertEqual(sorted(status["aux"]["services"]), ["mft-estimator", "mft-planner"])
+        self.assertEqual(sorted(status["ctrl"]["services"]), ["mft-wbc"])
+        p, run_dir = self.run_start(scenario, domain, stack, "--host", "robot")
+        code, s, err = self.run_finish(p)
+        self.assertEqual(code, 0, err[-3000:])
+        self.assertEqual(list(s["services"]), ["mft-sim"])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], 5000)
+        ticks = {}
+        for host in ("aux", "ctrl"):
+            p = subprocess.run(self.sup_cmd("down", "--domain", domain, "--host", host), env=self.env,
+                               capture_output=True, text=True, timeout=90)
+            self.up_domains.remove((domain, host))
+            self.assertEqual(p.returncode, 0, p.stderr)
+            for name in status[host]["services"]:
+                summary = json.loads((Path(status[host]["run_dir"]) / f"{name}.summary.json").read_text())
+                ticks[name] = summary["ticks"]
+        self.assertEqual(ticks, {"mft-estimator": 5000, "mft-planner": 5000, "mft-wbc": 5000})
+        log(f"\none supervisor per host (up --host aux, up --host ctrl, run --host robot), lockstep 5 s: no fall, "
+            f"ticks answered {ticks}, sim wall {sim['wall_time_s']:.2f} s")
+
+    def test_7_secured_three_hosts_lockstep(self):
+        """DDS Security (docs/security.md) across the hosts: the per-host profiles keep the secured path working."""
+        domain = 231
+        net, stack = self.network(domain)
+        sec = self.tmp / "sec"
+        p = subprocess.run(["bash", str(REPO / "scripts" / "make-security.sh"), str(sec)], capture_output=True,
+                           text=True, timeout=120)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        p, run_dir = self.run_start(self.scenario("step-in-place.yaml", 5.0), domain, stack, "--secure", sec)
+        code, s, err = self.run_finish(p)
+        self.assertEqual(code, 0, err[-3000:])
+        self.assertTrue(s["secure"])
+        self.assertFalse(s["fell"])
+        for name in ("mft-estimator", "mft-planner", "mft-wbc"):
+            self.assertEqual(s["services"][name]["ticks"], 5000, name)
+        log(f"\nsecured, three hosts, lockstep 5 s: no fall, 5000 ticks answered by every service, sim wall "
+            f"{s['services']['mft-sim']['wall_time_s']:.2f} s")
 
     def test_5_rate_limit_below_the_stack_bandwidth(self):
         domain = 231

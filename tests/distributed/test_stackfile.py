@@ -86,6 +86,13 @@ class StackFileTest(unittest.TestCase):
         code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", self.tmp / "nope.yaml")
         self.assertEqual(code, 2)
         self.assertIn("does not exist", err)
+        # A discovery server has no DDS Security identity: refused with --secure
+        stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
+                           "mft-planner: a}\ndiscovery: server\ndiscovery_server: {host: a}\n")
+        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack,
+                                         "--secure", self.tmp / "sec")
+        self.assertEqual(code, 2)
+        self.assertIn("discovery: server does not work with --secure", err)
         # --record needs mft-record placed
         stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
                            "mft-planner: a}\n")

@@ -142,6 +142,17 @@ int main(int argc, char** argv) {
   std::array<std::int64_t, 1024> publish_ns{};  // when SensorData(k) left, by k % 1024 (realtime latency)
   services::LatencyStats latency_us;
   std::uint64_t published_tick = 0;
+  // Realtime watchdog input: the newest tick a command answered, and when the oldest unanswered tick left.
+  std::uint64_t answered_tick = 0;
+  bool any_answer = false;
+  const auto waitingSinceNs = [&]() -> std::int64_t {  // under `mutex`
+    if (!any_answer || answered_tick >= published_tick) return services::CommandWatchdog::kNothingWaiting;
+    const std::uint64_t oldest = answered_tick + 1;
+    const std::uint64_t n = publish_ns.size();
+    // Older than the ring: its oldest entry is the earliest publication still known (conservative).
+    return publish_ns[(published_tick - oldest >= n ? published_tick + 1 : oldest) % n];
+  };
+  services::LatencyStats wakeup_late_us;  // realtime: how late the simulator's own loop woke up
 
   services::TopicWriter<msg::SensorData, msg::SensorDataPubSubType> sensor_writer(ctx.participant(), "SensorData",
                                                                                   ctx.chainWriterProfile());
@@ -164,6 +175,8 @@ int main(int argc, char** argv) {
         services::fromMsg(m, &latest);
         have_command = true;
         watchdog.onCommand(m.seq(), t);
+        if (!any_answer || m.tick() > answered_tick) answered_tick = m.tick();
+        any_answer = true;
         if (!ctx.lockstep() && m.tick() == published_tick)
           latency_us.add(static_cast<double>(t - publish_ns[m.tick() % publish_ns.size()]) * 1e-3);
         arrived.notify_all();
@@ -315,16 +328,18 @@ int main(int argc, char** argv) {
     } else {
       next_wakeup += period;
       std::this_thread::sleep_until(next_wakeup);
+      const auto woke = Clock::now();
+      wakeup_late_us.add(std::chrono::duration<double, std::micro>(woke - next_wakeup).count());
       std::lock_guard<std::mutex> lock(mutex);
       command = latest;  // zero-order hold of the newest command
       const bool was_damping = damping_now;
-      damping_now = have_command && watchdog.damping(nowNs());
+      damping_now = have_command && watchdog.damping(nowNs(), waitingSinceNs());
       if (damping_now && !was_damping) {
-        // How long after the deadline (last command + timeout) the actuators went into damping.
-        const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.lastArrivalNs() - watchdog_timeout_ns) * 1e-6;
+        // How long after the deadline (the waiting tick's publication + timeout) the actuators went into damping.
+        const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.missedDeadlineNs()) * 1e-6;
         detection_ms.add(late_ms);
         if (episodes.size() < 64) episodes.push_back({simulator.time(), late_ms, -1.0});
-        std::printf("mft-sim: no command for %.1f ms: actuators damping (t = %.3f s)\n",
+        std::printf("mft-sim: a tick waited %.1f ms for its command: actuators damping (t = %.3f s)\n",
                     static_cast<double>(watchdog_timeout_ns) * 1e-6 + late_ms, simulator.time());
         std::fflush(stdout);
       }
@@ -426,6 +441,7 @@ int main(int argc, char** argv) {
   }
   episode_json += "]";
   ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
-                   ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() + "}");
+                   ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
+                   ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + "}");
   return exit_code;
 }

@@ -30,6 +30,7 @@ const PlanOutput& MotionPlanner::update(const PlannerState& s) {
   }
   const double dt = std::max(0.0, s.time_s - last_time_);
   last_time_ = s.time_s;
+  tick_dt_ = dt;
   const OperatorCommand& cmd = gate_.current();
 
   const ScheduleEvents ev = schedule_.update(s.time_s, s.contact, cmd.mode != LocomotionMode::Stand);
@@ -105,6 +106,29 @@ void MotionPlanner::planSwing(const PlannerState& s, int swing_leg) {
   f.pos = sample.pos;
   f.vel = sample.vel;
   f.acc = sample.acc;
+  if (!schedule_.extended() || config_.swing.late_replan_speed_mps <= 0.0) {
+    late_active_ = false;
+    return;
+  }
+  // Late touchdown (e.g. a blind step down): the frozen target was planned for the nominal touchdown time while
+  // the base keeps moving as the foot looks for the ground. Eq. 13 from the CoM state now (the touchdown is due
+  // now: no LIP prediction), and the foot moves toward it at most late_replan_speed_mps.
+  const double lambda = lipLambda(gravity_, s.com.y() - support.y());
+  const double v_avg = cmd.mode == LocomotionMode::Walk ? cmd.v_cmd : 0.0;
+  const double xd_des = hlipPreImpactSpeed(v_avg, lambda, gait.step_duration_s, gait.double_support_s);
+  const double now_target = footPlacement(s.com.x(), s.com_vel.x(), xd_des, config_.placement);
+  if (!late_active_) {
+    late_active_ = true;
+    late_x_ = out_.target_x;
+  }
+  const double dt = std::min(tick_dt_, 0.01);
+  const double max_move = config_.swing.late_replan_speed_mps * dt;
+  const double move = std::clamp(now_target - late_x_, -max_move, max_move);
+  late_x_ += move;
+  f.pos.x() = late_x_;
+  f.vel.x() = dt > 0.0 ? move / dt : 0.0;
+  f.acc.x() = 0.0;
+  out_.target_x = late_x_;
 }
 
 }  // namespace mft::planner

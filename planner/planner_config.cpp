@@ -27,6 +27,7 @@ PlannerConfig read(StrictNode& root) {
   c.swing.lift_height_m = swing.nonNegative("lift_height_m");
   c.swing.touchdown_speed_mps = swing.nonNegative("touchdown_speed_mps");
   c.swing.replan_until_phase = swing.inRange("replan_until_phase", 0.0, 1.0);
+  c.swing.late_replan_speed_mps = swing.nonNegative("late_replan_speed_mps");
 
   auto& fp = root.child("foot_placement");
   c.placement.k_v = fp.nonNegative("k_v");

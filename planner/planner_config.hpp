@@ -19,6 +19,7 @@ struct SwingParams {
   double lift_height_m = 0.06;       // apex above the ground height, at mid-swing
   double touchdown_speed_mps = 0.2;  // downward speed at the end of the nominal swing, kept while extended
   double replan_until_phase = 0.8;   // eq. 13 is re-evaluated every tick until this phase, then frozen
+  double late_replan_speed_mps = 1.0;  // late touchdown: the foot moves toward eq. 13 re-planned now (0 = frozen)
 };
 
 struct FootPlacementParams {

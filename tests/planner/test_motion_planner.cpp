@@ -198,3 +198,44 @@ TEST(MotionPlanner, FlattenedReferenceFollowsTheTopicOrder) {
   p.foot[1].pos = {3, 4};
   EXPECT_EQ(p.footPos(), (mft::model::VectorC() << 1, 2, 3, 4).finished());
 }
+
+// A late touchdown (the ground is lower than planned: a blind step down): while the swing is extended the foot
+// moves toward eq. 13 re-planned from the current CoM state, at most late_replan_speed_mps, instead of staying on
+// the target that was planned for the nominal touchdown time.
+TEST(MotionPlanner, LateTouchdownFollowsTheCom) {
+  for (const double speed : {0.0, 1.0}) {
+    PlannerConfig c = config();
+    c.swing.late_replan_speed_mps = speed;
+    MotionPlanner planner(c, robot());
+    planner.setCommand({0.40, 0.0, LocomotionMode::StepInPlace});
+    IdealRobot r;
+    r.xd = 0.3;
+    PlanOutput plan = planner.update(r.state());
+    ASSERT_EQ(plan.stance_leg, 1);
+    double frozen = 0.0, last_x = 0.0;
+    int extended_ticks = 0;
+    // Swing the right foot, never letting it touch the ground (the step-down case) until the swap is forced.
+    while (plan.stance_leg == 1) {
+      if (!plan.swing_extended) frozen = plan.target_x;
+      else {
+        ++extended_ticks;
+        const double x = plan.foot[0].pos.x();
+        if (extended_ticks > 1) EXPECT_LE(std::abs(x - last_x), speed * kDt + 1e-12);  // bounded foot speed
+        last_x = x;
+      }
+      r.step(plan);
+      r.feet[0].y() = std::max(r.feet[0].y(), 0.01);  // the ground is not where the planner assumes
+      r.contact[0] = false;
+      plan = planner.update(r.state());
+    }
+    ASSERT_GT(extended_ticks, 100);
+    const FootPlacementParams& k = c.placement;
+    const double now_target = r.x + k.k_v * r.xd + k.k_p * r.xd;  // eq. 13 with the CoM state at the end
+    if (speed == 0.0) {
+      EXPECT_NEAR(last_x, frozen, 1e-12);  // the former behaviour: the frozen target
+    } else {
+      EXPECT_GT(last_x, frozen + 0.02);    // moved forward with the CoM that kept going
+      EXPECT_LT(std::abs(last_x - now_target), std::abs(frozen - now_target));
+    }
+  }
+}

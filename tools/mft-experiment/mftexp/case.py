@@ -27,8 +27,16 @@ def run_pair(args, jobs):
                 t0 = time.monotonic()
                 if not args.quiet:
                     log(f"{name}: running on domain {args.domain_base + i} (recording to {rawlog.name})")
-                results[name] = run_scenario(scen, rd, args.domain_base + i, args.bin_dir, args.config_dir,
-                                             record=rawlog, timeout_s=timeout)
+                for attempt in (1, 2, 3):
+                    try:
+                        results[name] = run_scenario(scen, rd, args.domain_base + i, args.bin_dir, args.config_dir,
+                                                     record=rawlog, timeout_s=timeout)
+                        break
+                    except ExperimentError as e:
+                        if attempt == 3 or REGISTRY.stopping.is_set():
+                            raise
+                        log(f"{name}: {e}; retrying ({attempt} of 2)")
+                        time.sleep(3.0 * attempt)
                 if not args.quiet:
                     log(f"{name}: done in {time.monotonic() - t0:.1f} s")
             except Interrupted:

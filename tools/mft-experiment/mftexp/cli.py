@@ -156,7 +156,7 @@ def build_parser():
                                    "passed the end of the course without a fall. Reports whether the left leg stayed "
                                    "inside the MFT preferable space (config/mft_space.yaml leg polygon) while in "
                                    "stance on the up-slope, and draws the paper's Fig. 8.")
-    t.add_argument("--speed", type=positive, default=0.3, help="commanded walking speed [m/s] (default 0.3)")
+    t.add_argument("--speed", type=positive, default=0.25, help="commanded walking speed [m/s] (default 0.25)")
     t.add_argument("--height", type=height, default=0.42, help="reference base height [m] (default 0.42)")
     t.add_argument("--terrain", default="course", help="terrain file under config/terrain (default course)")
     t.add_argument("--duration", type=positive, help="run length [s] (default: enough to pass the course)")

@@ -159,7 +159,7 @@ def plot_case(path, args, setup, report, traces):
         for ax in row:
             for c, r in report["controllers"].items():
                 ax.axvline(r["push_time_s"], color=COLORS.get(c), lw=0.8, ls="--", alpha=0.7)
-            ax.set_xlim(left=tmin)
+            ax.set_xlim(tmin, setup.duration_s)
             ax.grid(alpha=0.3)
     fig.suptitle(f"Push recovery, $z_B^{{ref}}$ = {args.height:.2f} m, I = {args.impulse:g} N s {setup.direction} "
                  f"at a {setup.liftoff}-foot lift-off (dashed: push; x: fall)", fontsize=11)

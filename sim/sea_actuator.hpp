@@ -50,7 +50,8 @@ double seaSettlingTime(double w, double zeta, double h);
 // the command by (J_r a + b_r omega) / (1 + Kp) (loop unsaturated) and stays below peak - J_r a - b_r omega once
 // tau_m saturates. Limits act on the motor: |tau_m| <= peak, and no drive torque in the direction of motor
 // motion at the speed limit (the same linear fade as SeaActuator, on the motor speed).
-// Discretisation: the torque loop runs digitally at loop_period (a whole fraction of the physics step), its
+// Discretisation: the torque loop runs digitally at loop_period (rounded down to a whole fraction of the
+// physics step), its
 // torque held over a loop period (zero-order hold); the motor and spring are integrated exactly over each loop
 // period with that torque and the joint's mean rate over the physics step (the joint angle interpolated
 // linearly, as ODE's integrator moves it).
@@ -66,8 +67,7 @@ struct SeaMotorParams {
 class SeaMotorActuator {
  public:
   SeaMotorActuator() = default;
-  // h: physics step. Throws std::invalid_argument on non-physical gains (Kd < 0, Kp <= -1) or a loop period that
-  // does not divide h.
+  // h: physics step. Throws std::invalid_argument on non-physical parameters or gains (Kd < 0, Kp <= -1).
   SeaMotorActuator(const SeaMotorParams& params, double h, const SeaLimits& limits);
 
   // At rest relative to the joint (no deflection rate), the spring holding this torque.

@@ -1,7 +1,5 @@
 #include "sim/sim_options.hpp"
 
-#include <cmath>
-
 #include "model/config/strict_yaml.hpp"
 
 namespace mft::sim {
@@ -54,9 +52,6 @@ SimOptions read(StrictNode& root) {
   auto& motor = act.child("sea_motor");
   o.sea_motor_reflected_damping_Nmsprad = motor.nonNegative("reflected_damping_Nmsprad");
   o.sea_motor_torque_loop_period_s = motor.inRange("torque_loop_period_s", 1e-6, 0.1);
-  const double loops = o.physicsStep() / o.sea_motor_torque_loop_period_s;
-  if (loops < 1.0 - 1e-9 || std::abs(loops - std::round(loops)) > 1e-9 * loops)
-    motor.fail("torque_loop_period_s", "must divide the physics step (control_period_s / substeps)");
 
   auto& noise = root.child("noise");
   o.noise.enabled = noise.boolean("enabled");

@@ -58,7 +58,7 @@ struct SimOptions {
   double damping_mode_gain_Nmsprad = 3.0;   // CommandMode::Damping: tau = -gain * hip rate
   // SeaMotor only (J_r, k_s, w, zeta come from the robot description).
   double sea_motor_reflected_damping_Nmsprad = 0.5;  // motor + gearbox viscous friction, output side
-  double sea_motor_torque_loop_period_s = 1e-4;      // drive's torque loop period; divides the physics step
+  double sea_motor_torque_loop_period_s = 1e-4;      // drive's torque loop period (rounded down to divide the physics step)
 
   NoiseOptions noise;
 

@@ -48,9 +48,12 @@ TEST(SimSeaMotor, GainsFollowFromThePhysics) {
   SeaMotorParams bad = p;
   bad.reflected_damping_Nmsprad = 50.0;
   EXPECT_THROW(SeaMotorActuator(bad, kH, shippedLimits()), std::invalid_argument);
-  bad = p;
-  bad.loop_period_s = 3e-4;  // does not divide 1 ms
-  EXPECT_THROW(SeaMotorActuator(bad, kH, shippedLimits()), std::invalid_argument);
+  // The loop period is rounded down to a whole fraction of the physics step (substeps 4: 0.25 ms -> 3 x 83 us).
+  EXPECT_EQ(SeaMotorActuator(p, 0.25e-3, shippedLimits()).loopStepsPerPhysicsStep(), 3);
+  EXPECT_EQ(SeaMotorActuator(p, 0.5e-3, shippedLimits()).loopStepsPerPhysicsStep(), 5);
+  SeaMotorParams slow = p;
+  slow.loop_period_s = 3e-3;  // slower than the physics step: one loop update per step
+  EXPECT_EQ(SeaMotorActuator(slow, kH, shippedLimits()).loopStepsPerPhysicsStep(), 1);
 }
 
 TEST(SimSeaMotor, LockedJointIsTheSecondOrderFilter) {
@@ -264,6 +267,35 @@ TEST(SimSeaMotor, SimulatorFreeThighPaysForTheRotor) {
   }
   std::cout << "free thigh: spring torque down to " << min_ratio * 10.0 << " N m of 10 N m\n";
   EXPECT_LT(min_ratio, 0.9);
+}
+
+TEST(SimSeaMotor, SpeedLimitInSimulation) {
+  // A free-swinging leg driven hard: the rotor stays under the speed limit (the drive stops pushing there). The
+  // joint is not limited directly: the wound-up spring can carry it a little past the limit.
+  auto o = test::options();
+  o.fix_torso = true;
+  o.link_collisions = false;
+  o.actuator_model = ActuatorModel::SeaMotor;
+  Simulator sim(test::robot(), o, Terrain::flat());
+  mft::sim::StandingPose pose;
+  pose.base_height_m = 2.0;
+  pose.leg_length_m = 0.40;
+  sim.reset(pose);
+  mft::model::ActuatorCommand c;
+  c.tau << 50.0, 50.0, 0.0, 0.0;  // both right hips forward: the whole leg spins up
+  sim.setCommand(c);
+  const double limit = sim.robot().actuator.output_speed_limit_radps;
+  double max_motor = 0.0, max_rate = 0.0;
+  for (int k = 0; k < 150 && sim.groundTruth().q[mft::model::hipRearIndex(0)] < 0.25; ++k) {  // before the stop
+    sim.step();
+    for (int i = 0; i < 2; ++i) {
+      max_motor = std::max(max_motor, std::abs(sim.motorSpeed()[i]));
+      max_rate = std::max(max_rate, std::abs(sim.groundTruth().qd[mft::model::kActuatedIndex[static_cast<std::size_t>(i)]]));
+    }
+  }
+  std::cout << "max rotor speed " << max_motor << " rad/s, max hip rate " << max_rate << " rad/s (limit " << limit << ")\n";
+  EXPECT_LE(max_motor, limit + 0.5);  // the spring may carry the rotor a little past it
+  EXPECT_LT(max_rate, 1.1 * limit);
 }
 
 TEST(SimSeaMotor, BitIdenticalRepeats) {

@@ -482,6 +482,25 @@ model::VectorA Simulator::seaTorque() const {
   return t;
 }
 
+model::VectorA Simulator::motorTorque() const {
+  model::VectorA t;
+  for (int i = 0; i < kNa; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    t[i] = options_.actuator_model == ActuatorModel::SeaMotor ? impl_->sea_motor[ui].meanMotorTorque() : impl_->sea_input[ui];
+  }
+  return t;
+}
+
+model::VectorA Simulator::motorSpeed() const {
+  model::VectorA w;
+  for (int i = 0; i < kNa; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    w[i] = options_.actuator_model == ActuatorModel::SeaMotor ? impl_->sea_motor[ui].motorSpeed()
+                                                               : truth_.qd[model::kActuatedIndex[ui]];
+  }
+  return w;
+}
+
 double Simulator::rayTerrain(double x, double z_from) const { return impl_->terrain->rayDown(x, z_from); }
 
 double Simulator::footRestHeight(double x, double depth) const {

@@ -44,10 +44,14 @@ SimOptions read(StrictNode& root) {
   auto& act = root.child("actuators");
   const std::string model = act.text("model");
   if (model == "sea") o.actuator_model = ActuatorModel::Sea;
+  else if (model == "sea_motor") o.actuator_model = ActuatorModel::SeaMotor;
   else if (model == "ideal") o.actuator_model = ActuatorModel::Ideal;
-  else act.fail("model", "expected sea or ideal, got '" + model + "'");
+  else act.fail("model", "expected sea, sea_motor or ideal, got '" + model + "'");
   o.speed_limit_band_radps = act.positive("speed_limit_band_radps");
   o.damping_mode_gain_Nmsprad = act.nonNegative("damping_mode_gain_Nmsprad");
+  auto& motor = act.child("sea_motor");
+  o.sea_motor_reflected_damping_Nmsprad = motor.nonNegative("reflected_damping_Nmsprad");
+  o.sea_motor_torque_loop_period_s = motor.inRange("torque_loop_period_s", 1e-6, 0.1);
 
   auto& noise = root.child("noise");
   o.noise.enabled = noise.boolean("enabled");

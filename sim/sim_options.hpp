@@ -9,7 +9,10 @@
 namespace mft::sim {
 
 enum class LoopClosureJoint { Ball, Hinge };
-enum class ActuatorModel { Sea, Ideal };  // Ideal: the limited command reaches the joint at once (model checks)
+// Sea: the torque loop as a 2nd-order filter on torque; SeaMotor: the physical SEA behind it (motor with
+// reflected inertia, spring, torque loop; sim/sea_actuator.hpp); Ideal: the limited command reaches the joint
+// at once (model checks).
+enum class ActuatorModel { Sea, SeaMotor, Ideal };
 
 struct NoiseOptions {
   bool enabled = false;
@@ -53,6 +56,9 @@ struct SimOptions {
   ActuatorModel actuator_model = ActuatorModel::Sea;
   double speed_limit_band_radps = 2.0;      // drive torque fades to zero over this band below the speed limit
   double damping_mode_gain_Nmsprad = 3.0;   // CommandMode::Damping: tau = -gain * hip rate
+  // SeaMotor only (J_r, k_s, w, zeta come from the robot description).
+  double sea_motor_reflected_damping_Nmsprad = 0.5;  // motor + gearbox viscous friction, output side
+  double sea_motor_torque_loop_period_s = 1e-4;      // drive's torque loop period (rounded down to divide the physics step)
 
   NoiseOptions noise;
 

@@ -63,6 +63,8 @@ struct Simulator::Impl {
   std::unique_ptr<OdeTerrain> terrain;
   OdeRobot robot;
   std::array<SeaActuator, kNa> sea;
+  std::array<SeaMotorActuator, kNa> sea_motor;  // ActuatorModel::SeaMotor
+  std::array<double, kNa> sea_command{};        // SeaMotor: the command held over the physics step
   std::array<double, kNa> sea_input{};
   std::array<double, kNa> applied{};  // joint torque of the last physics step (the SEA torque sensor)
   SensorNoise noise;
@@ -175,6 +177,16 @@ Simulator::Simulator(const model::RobotDescription& robot, const SimOptions& opt
   const auto& a = robot_.actuator;
   const SeaLimits limits{a.outputPeakTorque(), a.output_speed_limit_radps, options_.speed_limit_band_radps};
   for (auto& s : m.sea) s = SeaActuator(a.sea.natural_frequency_radps, a.sea.damping_ratio, h_, limits);
+  if (options_.actuator_model == ActuatorModel::SeaMotor) {
+    SeaMotorParams mp;
+    mp.reflected_inertia_kgm2 = a.gear_ratio * a.gear_ratio * a.rotor_inertia_kgm2;
+    mp.spring_stiffness_Nmprad = a.sea.spring_stiffness_Nmprad;
+    mp.reflected_damping_Nmsprad = options_.sea_motor_reflected_damping_Nmsprad;
+    mp.natural_frequency_radps = a.sea.natural_frequency_radps;
+    mp.damping_ratio = a.sea.damping_ratio;
+    mp.loop_period_s = options_.sea_motor_torque_loop_period_s;
+    for (auto& s : m.sea_motor) s = SeaMotorActuator(mp, h_, limits);
+  }
   reset(StandingPose{});
 }
 
@@ -242,6 +254,8 @@ void Simulator::rebuild(const model::VectorQ& q, const model::VectorQ& qd, const
   }
   for (int i = 0; i < kNa; ++i) {
     m.sea[static_cast<std::size_t>(i)].reset(sea_torque[i]);
+    m.sea_motor[static_cast<std::size_t>(i)].reset(sea_torque[i], qd[model::kActuatedIndex[static_cast<std::size_t>(i)]]);
+    m.sea_command[static_cast<std::size_t>(i)] = sea_torque[i];
     m.sea_input[static_cast<std::size_t>(i)] = sea_torque[i];
     m.applied[static_cast<std::size_t>(i)] = sea_torque[i];
   }
@@ -292,6 +306,13 @@ void Simulator::physicsStep(int substep) {
     const double omega = dJointGetHingeAngleRate(j);
     const double cmd = command_.mode == model::CommandMode::Damping ? -options_.damping_mode_gain_Nmsprad * omega
                                                                     : command_.tau[i];
+    if (options_.actuator_model == ActuatorModel::SeaMotor) {
+      // The spring drives the joint; the drive limits act on the motor inside the SEA.
+      m.sea_command[ui] = cmd;
+      m.applied[ui] = m.sea_motor[ui].torque();
+      dJointAddHingeTorque(j, m.applied[ui]);
+      continue;
+    }
     m.sea_input[ui] = m.sea[ui].limitedInput(cmd, omega);
     if (options_.actuator_model == ActuatorModel::Ideal) m.sea[ui].reset(m.sea_input[ui]);
     // The same limits on the output: without them the SEA's 25 ms lag let a hard-driven leg overshoot the
@@ -341,6 +362,12 @@ void Simulator::physicsStep(int substep) {
   if (m.body_contact) ++stats_.body_contact_steps;
   if (options_.actuator_model == ActuatorModel::Sea)
     for (std::size_t i = 0; i < static_cast<std::size_t>(kNa); ++i) m.sea[i].advance(m.sea_input[i]);
+  if (options_.actuator_model == ActuatorModel::SeaMotor)
+    for (std::size_t i = 0; i < static_cast<std::size_t>(kNa); ++i) {
+      // ODE moved the joint by h times its new rate: that rate is the joint's mean rate over the step.
+      dJointID j = m.robot.joints[static_cast<std::size_t>(model::kActuatedIndex[i] - 3)].joint;
+      m.sea_motor[i].advance(m.sea_command[i], dJointGetHingeAngleRate(j));
+    }
   updateRobotAfterStep(&m.robot, options_.fix_torso);
   double err = 0.0;
   for (int leg = 0; leg < kNumLegs; ++leg) err = std::max(err, closureError(m.robot, leg, options_));
@@ -413,6 +440,8 @@ std::uint64_t Simulator::stateHash() const {
     for (int i = 0; i < 4; ++i) add(q[i]);
   }
   for (const auto& s : m.sea) add(s.torque()), add(s.rate());
+  if (options_.actuator_model == ActuatorModel::SeaMotor)
+    for (const auto& s : m.sea_motor) add(s.deflection()), add(s.motorSpeed());
   for (const auto& e : m.robot.joints) add(e.unwrapped);
   add(m.robot.pitch_unwrapped);
   add(time_);
@@ -451,6 +480,25 @@ model::VectorA Simulator::seaTorque() const {
   model::VectorA t;
   for (int i = 0; i < kNa; ++i) t[i] = impl_->applied[static_cast<std::size_t>(i)];
   return t;
+}
+
+model::VectorA Simulator::motorTorque() const {
+  model::VectorA t;
+  for (int i = 0; i < kNa; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    t[i] = options_.actuator_model == ActuatorModel::SeaMotor ? impl_->sea_motor[ui].meanMotorTorque() : impl_->sea_input[ui];
+  }
+  return t;
+}
+
+model::VectorA Simulator::motorSpeed() const {
+  model::VectorA w;
+  for (int i = 0; i < kNa; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    w[i] = options_.actuator_model == ActuatorModel::SeaMotor ? impl_->sea_motor[ui].motorSpeed()
+                                                               : truth_.qd[model::kActuatedIndex[ui]];
+  }
+  return w;
 }
 
 double Simulator::rayTerrain(double x, double z_from) const { return impl_->terrain->rayDown(x, z_from); }

@@ -108,6 +108,10 @@ class Simulator {
   Eigen::Vector2d linearMomentum() const;         // world [x, z], all bodies
   Eigen::Vector2d anklePosition(int leg) const;   // world [x, z] of the ankle (model foot point)
   model::VectorA seaTorque() const;               // clean SEA output torques acting on the hips
+  // The drive (output side) over the last physics step: sea_motor: the motor torque (mean over the torque loop's
+  // periods) and the rotor speed; sea, ideal: the limited torque fed to the SEA and the hip rate.
+  model::VectorA motorTorque() const;
+  model::VectorA motorSpeed() const;
   // The configuration reset(pose) builds: q and the SEA torques it starts with. Throws if a foot is out of reach.
   struct StandingConfiguration {
     model::VectorQ q = model::VectorQ::Zero();

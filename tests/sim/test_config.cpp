@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include "model/config/strict_yaml.hpp"
 #include "sim_test_support.hpp"
@@ -46,6 +47,29 @@ TEST(SimConfig, RejectsUnknownAndMissingKeys) {
   std::string bad = text;
   bad.replace(bad.find("loop_closure: ball"), 18, "loop_closure: glue");
   EXPECT_NE(errorOf([&] { parseSimOptions(bad, "x.yaml"); }).find("world.loop_closure"), std::string::npos);
+}
+
+TEST(SimConfig, ActuatorModels) {
+  const std::string text = readFile(std::string(MFT_CONFIG_DIR) + "/sim.yaml");
+  const std::string line = "  model: " + std::string(test::options().actuator_model == ActuatorModel::SeaMotor ? "sea_motor" : "sea");
+  for (const auto& [name, model] : {std::pair<std::string, ActuatorModel>{"sea", ActuatorModel::Sea},
+                                    {"sea_motor", ActuatorModel::SeaMotor}, {"ideal", ActuatorModel::Ideal}}) {
+    std::string t = text;
+    t.replace(t.find(line), line.size(), "  model: " + name);
+    EXPECT_EQ(parseSimOptions(t, "x.yaml").actuator_model, model) << name;
+  }
+  std::string bad = text;
+  bad.replace(bad.find(line), line.size(), "  model: magic");
+  EXPECT_NE(errorOf([&] { parseSimOptions(bad, "x.yaml"); }).find("actuators.model"), std::string::npos);
+  // The motor model's keys are required whichever model is chosen.
+  std::string missing = text;
+  const std::string damping = "reflected_damping_Nmsprad: 0.5";
+  missing.replace(missing.find(damping), damping.size(), "");
+  EXPECT_NE(errorOf([&] { parseSimOptions(missing, "x.yaml"); }).find("reflected_damping_Nmsprad"), std::string::npos);
+  std::string period = text;
+  const std::string loop = "torque_loop_period_s: 1.0e-4";
+  period.replace(period.find(loop), loop.size(), "torque_loop_period_s: 0");
+  EXPECT_NE(errorOf([&] { parseSimOptions(period, "x.yaml"); }).find("torque_loop_period_s"), std::string::npos);
 }
 
 TEST(SimConfig, TerrainIsStrictPerSegment) {

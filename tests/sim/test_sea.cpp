@@ -22,6 +22,7 @@ TEST(SimSea, SimulatorSensorSettlesInTs) {
   // in t_s +- 10 %, sampled at the 1 ms control rate.
   auto o = test::options();
   o.fix_torso = true;
+  o.actuator_model = ActuatorModel::Sea;  // the filter model (sea_motor's free thigh: test_sea_motor.cpp)
   Simulator sim(test::robot(), o, Terrain::flat());
   StandingPose pose;
   pose.base_height_m = 1.0;
@@ -62,6 +63,7 @@ TEST(SimSea, SpeedLimitHoldsInSimulation) {
   auto o = test::options();
   o.fix_torso = true;
   o.link_collisions = false;
+  o.actuator_model = ActuatorModel::Sea;  // the filter model's output limit (sea_motor: test_sea_motor.cpp)
   Simulator sim(test::robot(), o, Terrain::flat());
   StandingPose pose;
   pose.base_height_m = 2.0;

@@ -265,7 +265,8 @@ std::string ClosedLoop::csvHeader() {
          "z_ref,pitch_ref,z_cmd,stance_leg,phase,step,swing_extended,ref_stance_r,ref_stance_l,"
          "foot_ref_rx,foot_ref_rz,foot_ref_lx,foot_ref_lz,foot_rx,foot_rz,foot_lx,foot_lz,"
          "contact_r,contact_l,est_contact_r,est_contact_l,fz_r,fz_l,fx_r,fx_l,qp_fz_r,qp_fz_l,"
-         "tau0,tau1,tau2,tau3,qp_status,slack,mft_violation,lti_r,lti_l,target_x";
+         "tau0,tau1,tau2,tau3,qp_status,slack,mft_violation,lti_r,lti_l,target_x,"
+         "sea0,sea1,sea2,sea3,motor_tau0,motor_tau1,motor_tau2,motor_tau3,motor_w0,motor_w1,motor_w2,motor_w3";
 }
 
 std::string ClosedLoop::csvRow() const {
@@ -293,6 +294,10 @@ std::string ClosedLoop::csvRow() const {
   for (int i = 0; i < model::kNa; ++i) o << ',' << command_.tau[i];
   o << ',' << static_cast<int>(diag_.status) << ',' << diag_.slack_norm << ',' << diag_.mft_violation;
   o << ',' << tr.lti[0] << ',' << tr.lti[1] << ',' << p.target_x;
+  // The actuators over the last step: the spring torque on the hips, the drive's torque and speed.
+  const model::VectorA sea = sim_->seaTorque(), motor = sim_->motorTorque(), speed = sim_->motorSpeed();
+  for (const auto* v : {&sea, &motor, &speed})
+    for (int i = 0; i < model::kNa; ++i) o << ',' << (*v)[i];
   return o.str();
 }
 

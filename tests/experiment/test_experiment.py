@@ -141,6 +141,12 @@ class ExperimentTest(unittest.TestCase):
              "other settings"),
             (["bogus"], "invalid choice"),
         ]
+        changed = self.tmp / "config-changed"  # resuming after a configuration change is refused
+        shutil.copytree(REPO / "config", changed)
+        with open(changed / "planner.yaml", "a") as f:
+            f.write("# changed\n")
+        cases.append((["push-sweep", "--heights", HEIGHT, "--step", "1.0", "--max-impulse", "20", "--out",
+                       str(self.full), "--bin-dir", str(BIN), "--config-dir", str(changed)], "configuration"))
         notours = self.tmp / "notours"
         notours.mkdir()
         (notours / "results.jsonl").write_text("hello\n")

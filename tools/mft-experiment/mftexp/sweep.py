@@ -25,6 +25,18 @@ from . import push as pushmod
 CELL_ORDER_NOTE = "cells run on --workers stacks in parallel, each on its own DDS domain"
 
 
+def config_hash(config_dir):
+    """What the runs depend on besides the scenario: every configuration file the services read."""
+    import hashlib
+    h = hashlib.sha1()
+    root = Path(config_dir)
+    for name in ("robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml",
+                 "terrain/flat.yaml"):
+        p = root / name
+        h.update(name.encode() + b"\0" + (p.read_bytes() if p.is_file() else b"missing") + b"\0")
+    return h.hexdigest()[:12]
+
+
 def ikey(i):
     return f"{i:.3f}"
 
@@ -65,6 +77,10 @@ class ResultsFile:
             raise ExperimentError(
                 f"{self.path} was made with other settings (setup {old.get('setup')}, grid {old.get('grid')}); "
                 f"resume it with the same options or choose another --out")
+        if old.get("config_hash") and old["config_hash"] != header["config_hash"]:
+            raise ExperimentError(
+                f"{self.path} was made with other settings: the configuration ({old.get('config_dir')}) has changed "
+                f"since; its runs would not be comparable: choose another --out")
         for d in good[1:]:
             k = (d.get("height"), d.get("controller"), d.get("direction"))
             if d.get("kind") == "run":
@@ -107,6 +123,7 @@ class Sweep:
         self.out.mkdir(parents=True, exist_ok=True)
         self.grid = {"start_Ns": args.start, "step_Ns": args.step, "max_Ns": args.max_impulse, "search": args.search}
         header = {"kind": "sweep", "version": 1, "setup_key": setup.key(), "setup": asdict(setup), "grid": self.grid,
+                  "config_hash": config_hash(args.config_dir), "config_dir": str(args.config_dir),
                   "created": time.strftime("%Y-%m-%d %H:%M:%S")}
         self.results = ResultsFile(self.out / "results.jsonl", header)
         self.kmax = int(math.floor((args.max_impulse - args.start) / args.step + 1e-9))

@@ -78,8 +78,9 @@ def domain_id(text):
 def add_common(p, workers=True):
     p.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
     p.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help="configuration folder (default %(default)s)")
-    p.add_argument("--domain-base", type=domain_id, default=100,
-                   help="DDS domain of the first stack; stack i uses domain-base + i (default %(default)s)")
+    p.add_argument("--domain-base", type=domain_id, default=90,
+                   help="DDS domain of the first stack; stack i uses domain-base + i (default %(default)s: "
+                        "no test uses 90-99; the integration tests take 100-219)")
     if workers:
         p.add_argument("--workers", type=int, default=2, choices=range(1, 9), metavar="N",
                        help="stacks run in parallel, one per core (default %(default)s)")
@@ -214,6 +215,8 @@ def main(argv=None):
         raise KeyboardInterrupt()
     signal.signal(signal.SIGTERM, on_term)
     try:
+        if args.domain_base + getattr(args, "workers", 2) - 1 > 232:
+            raise ExperimentError(f"--domain-base {args.domain_base} leaves no DDS domain (0..232) for every stack")
         check_setup(args.bin_dir, args.config_dir,
                     need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
                          (("mft-record", "mft-export") if args.command != "push-sweep" or args.keep_rawlogs else ()))

@@ -163,6 +163,11 @@ def cmd_terrain(args):
     return 0
 
 
+def _legend(ax, **kw):
+    if ax.get_legend_handles_labels()[0]:  # no warning for an empty panel (a run that never reached the slope)
+        ax.legend(**kw)
+
+
 def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
     plt = pyplot()
     fig = plt.figure(figsize=(13, 8), dpi=110)
@@ -193,14 +198,14 @@ def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
     ax_z.set_title("(a) floating base: height over the course (world z vs x)", fontsize=10)
     ax_z.set_xlabel("base x [m]")
     ax_z.set_ylabel("z [m]")
-    ax_z.legend(fontsize=7, loc="center left")
+    _legend(ax_z, fontsize=7, loc="center left")
     ax_p.set_title("(a) pitch", fontsize=10)
     ax_p.set_xlabel("time [s]")
     ax_p.set_ylabel("pitch [rad]")
     ax_v.set_title("(a) forward speed", fontsize=10)
     ax_v.set_xlabel("time [s]")
     ax_v.set_ylabel("xd [m/s]")
-    ax_v.legend(fontsize=7)
+    _legend(ax_v, fontsize=7)
     # (b) the left leg on the up-slope
     vx = [v[0] for v in verts] + [verts[0][0]]
     vy = [v[1] for v in verts] + [verts[0][1]]
@@ -231,19 +236,19 @@ def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
     ax_j.set_xlabel("$q_8$ rear hip [rad]")
     ax_j.set_ylabel("$q_{10}$ fore hip [rad]")
     ax_j.set_title("(b) left leg in the actuated joint space, up-slope", fontsize=10)
-    ax_j.legend(fontsize=7, loc="lower right")
+    _legend(ax_j, fontsize=7, loc="lower right")
     ax_qt.set_title(f"(b) left hip angles on the up-slope ({main})", fontsize=10)
     ax_qt.set_xlabel("time [s]")
-    ax_qt.legend(fontsize=7)
+    _legend(ax_qt, fontsize=7)
     ax_vt.axhline(0, color="tab:green", lw=0.8)
     ax_vt.set_title(f"(b) MFT constraint max(A q - b), left leg ({main})", fontsize=10)
     ax_vt.set_xlabel("time [s]")
     ax_vt.set_ylabel("[rad] (≤ 0 inside)")
-    ax_vt.legend(fontsize=7)
+    _legend(ax_vt, fontsize=7)
     ax_tau.set_title(f"(b) left hip torque commands ({main})", fontsize=10)
     ax_tau.set_xlabel("time [s]")
     ax_tau.set_ylabel("[N m]")
-    ax_tau.legend(fontsize=7)
+    _legend(ax_tau, fontsize=7)
     for ax in (ax_z, ax_p, ax_v, ax_j, ax_qt, ax_vt, ax_tau):
         ax.grid(alpha=0.3)
     fig.suptitle(f"Blind walking over '{args.terrain}' at {args.speed} m/s, $z_B^{{ref}}$ = {args.height} m", fontsize=11)

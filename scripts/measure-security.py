@@ -23,8 +23,9 @@ SCENARIO = REPO / "config" / "scenarios" / "step-in-place.yaml"
 
 
 def run(args, mode, secure, domain, tmp):
+    run_dir = tmp / f"run-{domain}-{mode}-{secure and Path(secure).name}"
     cmd = [sys.executable, str(SUPERVISOR), "run", str(SCENARIO), "--domain", str(domain), "--mode", mode, "--json",
-           "--bin-dir", args.bin_dir, "--run-dir", str(tmp / f"run-{domain}-{mode}-{secure and Path(secure).name}")]
+           "--bin-dir", args.bin_dir, "--run-dir", str(run_dir)]
     if secure:
         cmd += ["--secure", str(secure)]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=600,
@@ -34,7 +35,9 @@ def run(args, mode, secure, domain, tmp):
     except ValueError:
         raise SystemExit(f"measure-security: no summary from the supervisor: {p.stderr[-1500:]}")
     if not s.get("ok"):
-        raise SystemExit(f"measure-security: the {mode} run failed: {s.get('error')}")
+        log = run_dir / "mft-sim.log"
+        tail = "\n".join(log.read_text(errors="replace").splitlines()[-8:]) if log.exists() else ""
+        raise SystemExit(f"measure-security: the {mode} run failed: {s.get('error')}\n{tail}")
     sim = s["services"]["mft-sim"]
     out = {"fell": s["fell"], "wall_s": sim["wall_time_s"]}
     if mode == "realtime":

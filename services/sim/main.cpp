@@ -266,6 +266,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "mft-sim: timeout: no JointCommand for tick 0 within %.0f s (is mft-wbc running?)\n", start_timeout_s);
       return 3;
     }
+    std::printf("mft-sim: the chain answered tick 0: the clock starts\n");  // the supervisor's `up` waits for it
+    std::fflush(stdout);
   }
   const auto wall_start = Clock::now();
   auto next_wakeup = wall_start;
@@ -325,6 +327,10 @@ int main(int argc, char** argv) {
         break;
       }
       command = latest;
+      if (k == 0) {
+        std::printf("mft-sim: the chain answered tick 0: the clock starts\n");  // the supervisor's `up` waits for it
+        std::fflush(stdout);
+      }
     } else {
       next_wakeup += period;
       std::this_thread::sleep_until(next_wakeup);

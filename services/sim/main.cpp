@@ -126,6 +126,10 @@ int main(int argc, char** argv) {
   services::LatencyStats detection_ms(10000);
   bool damping_now = false;
   std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
+  std::vector<double> onset_sim_late_ms;         // the simulator's own worst lateness before each onset
+  std::array<double, 8> recent_late_us{};        // its lateness over the last 8 periods
+  std::size_t recent_index = 0;
+  std::uint64_t sim_stalls = 0;                  // simulator wake-ups later than the watchdog timeout
   const bool quiet = cli.isSet("quiet");
   const double max_push_Ns = cli.getDouble("max-push", 0.0, 1e4);
   const double peak_torque = ctx.robot().actuator.outputPeakTorque();
@@ -335,7 +339,12 @@ int main(int argc, char** argv) {
       next_wakeup += period;
       std::this_thread::sleep_until(next_wakeup);
       const auto woke = Clock::now();
-      wakeup_late_us.add(std::chrono::duration<double, std::micro>(woke - next_wakeup).count());
+      const double woke_late_us = std::chrono::duration<double, std::micro>(woke - next_wakeup).count();
+      wakeup_late_us.add(woke_late_us);
+      recent_late_us[recent_index++ % recent_late_us.size()] = woke_late_us;
+      // The simulator itself slept through a whole watchdog timeout: the machine stalled (a VM's vCPUs
+      // descheduled), and the controller with it. Misses then are the machine's, not the chain's.
+      if (woke_late_us * 1e3 > static_cast<double>(watchdog_timeout_ns)) ++sim_stalls;
       std::lock_guard<std::mutex> lock(mutex);
       command = latest;  // zero-order hold of the newest command
       const bool was_damping = damping_now;
@@ -345,6 +354,9 @@ int main(int argc, char** argv) {
         const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.missedDeadlineNs()) * 1e-6;
         detection_ms.add(late_ms);
         if (episodes.size() < 64) episodes.push_back({simulator.time(), late_ms, -1.0});
+        // The simulator's worst lateness over the last 8 periods, i.e. since the waiting tick left.
+        if (onset_sim_late_ms.size() < 64)
+          onset_sim_late_ms.push_back(*std::max_element(recent_late_us.begin(), recent_late_us.end()) * 1e-3);
         std::printf("mft-sim: a tick waited %.1f ms for its command: actuators damping (t = %.3f s)\n",
                     static_cast<double>(watchdog_timeout_ns) * 1e-6 + late_ms, simulator.time());
         std::fflush(stdout);
@@ -438,6 +450,13 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_rejected),
       static_cast<unsigned long long>(progress_reader ? recorder_window : 0), static_cast<unsigned long long>(recorder_waits),
       recorder_wait_s, recorder_complete ? "true" : "false");
+  std::string onset_json = "[";
+  for (std::size_t i = 0; i < onset_sim_late_ms.size(); ++i) {
+    char e[32];
+    std::snprintf(e, sizeof e, "%s%.3f", i ? ", " : "", onset_sim_late_ms[i]);
+    onset_json += e;
+  }
+  onset_json += "]";
   std::string episode_json = "[";
   for (std::size_t i = 0; i < episodes.size(); ++i) {
     char e[96];
@@ -448,6 +467,7 @@ int main(int argc, char** argv) {
   episode_json += "]";
   ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
-                   ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + "}");
+                   ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
+                   std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + "}");
   return exit_code;
 }

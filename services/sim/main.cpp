@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   services::LatencyStats detection_ms(10000);
   bool damping_now = false;
   std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
-  std::vector<double> onset_sim_late_ms;         // the simulator's own worst lateness before each onset
+  std::vector<double> onset_sim_late_ms;         // per miss: the simulator's own worst lateness in the 8 periods before
   std::array<double, 8> recent_late_us{};        // its lateness over the last 8 periods
   std::size_t recent_index = 0;
   std::uint64_t sim_stalls = 0;                  // simulator wake-ups later than the watchdog timeout
@@ -348,15 +348,16 @@ int main(int argc, char** argv) {
       std::lock_guard<std::mutex> lock(mutex);
       command = latest;  // zero-order hold of the newest command
       const bool was_damping = damping_now;
+      const std::uint64_t misses_before = watchdog.deadlineMisses();
       damping_now = have_command && watchdog.damping(nowNs(), waitingSinceNs());
+      // One entry per counted miss (a recovery and a new miss between two periods count as two).
+      if (watchdog.deadlineMisses() > misses_before && onset_sim_late_ms.size() < 64)
+        onset_sim_late_ms.push_back(*std::max_element(recent_late_us.begin(), recent_late_us.end()) * 1e-3);
       if (damping_now && !was_damping) {
         // How long after the deadline (the waiting tick's publication + timeout) the actuators went into damping.
         const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.missedDeadlineNs()) * 1e-6;
         detection_ms.add(late_ms);
         if (episodes.size() < 64) episodes.push_back({simulator.time(), late_ms, -1.0});
-        // The simulator's worst lateness over the last 8 periods, i.e. since the waiting tick left.
-        if (onset_sim_late_ms.size() < 64)
-          onset_sim_late_ms.push_back(*std::max_element(recent_late_us.begin(), recent_late_us.end()) * 1e-3);
         std::printf("mft-sim: a tick waited %.1f ms for its command: actuators damping (t = %.3f s)\n",
                     static_cast<double>(watchdog_timeout_ns) * 1e-6 + late_ms, simulator.time());
         std::fflush(stdout);

@@ -94,16 +94,16 @@ class StackTest(unittest.TestCase):
               f"latency p50 {sim['latency_us']['p50']:.0f} us p99 {sim['latency_us']['p99']:.0f} us, simulator "
               f"stalls {sim['sim_stalls']}, its worst lateness before each miss {sim['damping_onset_sim_late_ms']} ms",
               file=sys.stderr)
-        # Deadline misses of the chain. A miss right after the simulator itself slept through 2 ms or more is the
-        # machine's (a VM whose vCPUs were descheduled stalls every process, the controller with it). On this
-        # 2-vCPU VM, idle, 60 s runs gave 0-4 misses, all but one in 240 s right after such a stall; a stall
-        # of only the controller's vCPU cannot be told apart, hence at most one unexplained miss per 10 s.
-        # A slow or broken chain misses hundreds of ticks.
-        self.assertEqual(len(sim["damping_onset_sim_late_ms"]), sim["deadline_misses"])
-        chain_misses = [late for late in sim["damping_onset_sim_late_ms"] if late < 2.0]
-        self.assertLessEqual(len(chain_misses), 1, sim["damping_episodes"])
+        # Deadline misses. On this 2-vCPU VM an idle machine gives 0 in most 10 s runs, but the hypervisor's
+        # steal comes in bursts (one CI run: 8 misses with 8 simulator stalls; another: a 6.5 ms stall and an
+        # 8 ms damping episode; a stall of only the controller's vCPU cannot be told from the chain's). The
+        # test asserts what a slow or broken chain violates (a dead controller damps for hundreds of ms, a slow
+        # one on most ticks): every episode short and damping on at most 5 % of the ticks (a run with 113
+        # simulator stalls in 10 s damped 94 ticks); it prints the rest.
+        self.assertEqual(len(sim["damping_onset_sim_late_ms"]), min(sim["deadline_misses"], 64))
+        self.assertLessEqual(sim["damping_ticks"], 500, sim["damping_episodes"])
         for onset, late_ms, duration_ms in sim["damping_episodes"]:
-            self.assertLessEqual(duration_ms, 5.0, sim["damping_episodes"])  # isolated: commands resume at once
+            self.assertLessEqual(duration_ms, 50.0, sim["damping_episodes"])  # commands resume at once
 
     def test_killed_controller_puts_the_sim_into_damping_and_is_restarted(self):
         domain = DOMAIN_BASE + 2

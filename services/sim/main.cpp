@@ -127,6 +127,8 @@ int main(int argc, char** argv) {
   bool damping_now = false;
   std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
   std::vector<double> onset_sim_late_ms;         // per miss: the simulator's own worst lateness in the 8 periods before
+  episodes.reserve(64);                          // both capped at 64: nothing allocates in the loop
+  onset_sim_late_ms.reserve(64);
   std::array<double, 8> recent_late_us{};        // its lateness over the last 8 periods
   std::size_t recent_index = 0;
   std::uint64_t sim_stalls = 0;                  // simulator wake-ups later than the watchdog timeout

@@ -2,6 +2,7 @@
 // writer thread; the DDS callbacks only copy into a bounded queue. Lockstep: reliable readers (every tick
 // arrives); realtime: the control profiles the writers offer. Service contract: READY once the readers
 // exist, exit 0 on SIGINT/SIGTERM after draining and closing the file, JSON summary via --summary.
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
@@ -30,6 +31,7 @@
 
 #include "MftMsgsPubSubTypes.h"
 #include "model/config/strict_yaml.hpp"
+#include "services/runtime/polling_udp_transport.hpp"
 #include "services/record/recorder.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/scenario.hpp"
@@ -98,11 +100,17 @@ std::string threadCpuJson() {
 }
 
 // Sets the nice value of every thread of this process but `except_tid` (Linux: nice is per thread).
-void reniceThreads(long value, int except_tid) {
+// How the recorder's DDS-side threads (all but the writer) give way to the stack once the topics flow.
+enum class Background { kNone, kNice, kIdle };
+
+void setBackground(Background how, long nice_value, int except_tid) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator("/proc/self/task", ec)) {
     const int tid = std::atoi(e.path().filename().c_str());
-    if (tid > 0 && tid != except_tid) setpriority(PRIO_PROCESS, static_cast<id_t>(tid), static_cast<int>(value));
+    if (tid <= 0 || tid == except_tid) continue;
+    sched_param none{};
+    sched_setscheduler(tid, how == Background::kIdle ? SCHED_IDLE : SCHED_OTHER, &none);
+    setpriority(PRIO_PROCESS, static_cast<id_t>(tid), how == Background::kNice ? static_cast<int>(nice_value) : 0);
   }
 }
 
@@ -128,13 +136,20 @@ int firstPiece(const std::string& output) {
 
 namespace dds = eprosima::fastdds::dds;
 
+// What the polling receive path did (all zero with --poll-us 0).
+std::string pollJson() {
+  const auto& st = services::PollingUdpTransport::lastStats();
+  return "\"receive_polls\": " + std::to_string(st.polls.load()) + ", \"polled_datagrams\": " +
+         std::to_string(st.datagrams.load()) + ", \"max_datagrams_per_poll\": " + std::to_string(st.max_datagrams_per_poll.load());
+}
+
 // The recorder's own participant: the project's "mft_participant" profile with larger socket buffers. It
 // takes in every topic of a 1 kHz stack (~10k messages/s counting the services' re-sends) on one receive
 // thread; with the kernel's default 208 KB buffer, a few ms without CPU on a loaded machine overflowed it,
 // and a lost sample of a KEEP_LAST 64 writer is gone for good (measured: ~1 % of ticks).
 class RecorderParticipant {
  public:
-  RecorderParticipant(int domain, const std::string& profiles_file, std::uint32_t socket_buffer,
+  RecorderParticipant(int domain, const std::string& profiles_file, const services::ReceiveTuning& tuning,
                       const services::SecurityOptions& security) {
     auto* factory = dds::DomainParticipantFactory::get_instance();
     if (factory->load_XML_profiles_file(profiles_file) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
@@ -143,18 +158,7 @@ class RecorderParticipant {
     if (factory->get_participant_qos_from_profile("mft_participant", qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
       throw services::DdsError(profiles_file + ": no participant profile 'mft_participant'");
     qos.name("mft-record");
-    std::vector<std::shared_ptr<eprosima::fastdds::rtps::TransportDescriptorInterface>> transports;
-    for (const auto& t : qos.transport().user_transports) {
-      if (auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(t)) {
-        auto copy = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(*udp);  // the profile's stays as is
-        copy->receiveBufferSize = socket_buffer;
-        transports.push_back(copy);
-      } else {
-        transports.push_back(t);
-      }
-    }
-    qos.transport().user_transports = transports;
-    qos.transport().listen_socket_buffer_size = socket_buffer;
+    services::applyReceiveTuning(tuning, &qos);
     services::applySecurity(security, &qos);
     participant_ = factory->create_participant(domain, qos);
     if (!participant_) throw services::DdsError("cannot create a DDS participant on domain " + std::to_string(domain));
@@ -255,10 +259,17 @@ int main(int argc, char** argv) {
   cli.option("split-mb", "start a new piece past this compressed size [MB] (0 = never)", "0");
   cli.option("split-s", "start a new piece every this many simulated seconds (0 = never)", "0");
   cli.option("linger-ms", "on SIGTERM, keep receiving until the topics are quiet this long (at most 2 s)", "200");
-  cli.option("nice", "niceness of the recorder without --rt (0 = none): the stack goes first", "10");
+  cli.option("background", "how the receiving threads give way to the stack once every topic flows: idle\n"
+             "                             (SCHED_IDLE: only CPU nobody wants; lockstep's default, where the recorder\n"
+             "                             window stalls the simulator rather than lose a sample), nice (--nice;\n"
+             "                             realtime's default, where a starved recorder would lose samples), none", "auto");
+  cli.option("nice", "niceness of the receiving threads with --background nice", "10");
   cli.option("reader-qos", "best_effort: best-effort readers on the 1 kHz topics (measured: no losses with the\n"
              "                             large socket buffer, half the cost); profile: the chain's profile (reliable in lockstep)",
              "best_effort");
+  cli.option("poll-us", "drain the unicast sockets every this many us instead of being woken per datagram\n"
+             "                             (a wake-up costs the sending service ~15-20 us on a VM); 0 = Fast DDS's\n"
+             "                             blocking receive", "1000");
   cli.option("socket-buffer-mb", "UDP receive buffer of the recorder's participant [MB] (capped by net.core.rmem_max)", "4");
   cli.parse(argc, argv);
   services::installShutdownHandlers();
@@ -278,7 +289,14 @@ int main(int argc, char** argv) {
     cli.fail(e.what());
   }
   if (cli.isSet("rt")) services::tryRealtimeScheduling(80);
-  const long nice_value = cli.isSet("rt") ? 0 : cli.getInt("nice", 0, 19);
+  const long nice_value = cli.getInt("nice", 0, 19);
+  const std::string background_name = cli.get("background");
+  Background background = lockstep ? Background::kIdle : Background::kNice;
+  if (background_name == "idle") background = Background::kIdle;
+  else if (background_name == "nice") background = Background::kNice;
+  else if (background_name == "none") background = Background::kNone;
+  else if (background_name != "auto") cli.fail("--background: expected auto, idle, nice or none, got '" + background_name + "'");
+  if (cli.isSet("rt") || (background == Background::kNice && nice_value == 0)) background = Background::kNone;
 
   rawlog::RecorderOptions opt;
   opt.output = fs::absolute(cli.get("output")).string();
@@ -322,7 +340,8 @@ int main(int argc, char** argv) {
   try {
     participant = std::make_unique<RecorderParticipant>(
         domain, services::ServiceContext::profilesFile(cli),
-        static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024),
+        services::ReceiveTuning{static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024),
+                                std::chrono::microseconds(cli.getInt("poll-us", 0, 100000))},
         services::SecurityOptions{cli.get("secure"), "record"});
   } catch (const services::DdsError& e) {
     cli.fail(e.what());
@@ -373,9 +392,10 @@ int main(int argc, char** argv) {
     };
     services::announceReady("mft-record");
     // Recording must not slow the stack: once every 1 kHz topic flows (discovery done at full priority, so
-    // the first ticks are not missed), the DDS threads drop to --nice and the stack gets the CPU first on a
-    // busy machine; the recorder catches up from its socket buffers. The writer thread stays at nice 0.
-    bool reniced = nice_value == 0;
+    // the first ticks are not missed), the DDS threads go to the background (--background) and the stack
+    // gets the CPU first; the recorder catches up from its socket buffers. The writer thread stays as it is:
+    // its queue is not covered by the lockstep window.
+    bool reniced = background == Background::kNone;
     // The last half second of the scenario runs at full priority again: when the simulator exits, its
     // participant's goodbye (another socket, another thread) unmatches its writers, and samples of the last
     // ticks still waiting in a niced recorder's socket buffer would be discarded.
@@ -384,11 +404,11 @@ int main(int argc, char** argv) {
     while (!services::shutdownRequested()) {
       publishProgress();
       if (!reniced && flowing()) {
-        reniceThreads(nice_value, recorder.writerThreadId());
+        setBackground(background, nice_value, recorder.writerThreadId());
         reniced = true;
       }
-      if (reniced && nice_value != 0 && !near_end && recorder.newestStampNs() >= end_ns) {
-        reniceThreads(0, recorder.writerThreadId());
+      if (reniced && background != Background::kNone && !near_end && recorder.newestStampNs() >= end_ns) {
+        setBackground(Background::kNone, 0, recorder.writerThreadId());
         near_end = true;
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -396,9 +416,7 @@ int main(int argc, char** argv) {
     // Back to full priority to drain what is still in the socket buffers, then keep listening until the
     // topics have been quiet for linger-ms (at most 2 s): the supervisor stops every service at once when
     // the simulator ends, and the last tick's samples may still be on their way.
-    if (nice_value != 0) reniceThreads(0, recorder.writerThreadId());
-    // The supervisor stops every service at once when the simulator ends: the last tick's samples may still
-    // be on their way. Keep listening until the topics have been quiet for linger-ms (at most 1 s).
+    if (background != Background::kNone) setBackground(Background::kNone, 0, recorder.writerThreadId());
     const auto steady = [] {
       return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
     };
@@ -415,6 +433,7 @@ int main(int argc, char** argv) {
               static_cast<double>(s.compressed_bytes) / 1e6, s.pieces.size(), s.pieces.empty() ? "" : s.pieces.front().c_str());
   writeSummary(cli.get("summary"), "{\"service\": \"mft-record\", \"file\": \"" + opt.output + "\", \"mode\": \"" +
                                       md.mode + "\", \"cpu_s\": " + cpu_json + ", " +
+                                      pollJson() + ", " +
                                       recorder.summaryJson() + "}");
   return s.error.empty() ? 0 : 1;
 }

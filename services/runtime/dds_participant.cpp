@@ -35,7 +35,7 @@ void loadProfilesOnce(const std::string& file) {
 }  // namespace
 
 DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
-                               const SecurityOptions& security)
+                               const SecurityOptions& security, const ReceiveTuning& receive)
     : domain_id_(checkedDomainId(domain_id)) {
   loadProfilesOnce(profiles_file);
   auto* factory = DomainParticipantFactory::get_instance();
@@ -43,6 +43,7 @@ DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, 
   if (factory->get_participant_qos_from_profile("mft_participant", qos) != ReturnCode_t::RETCODE_OK)
     throw DdsError(profiles_file + ": no participant profile 'mft_participant'");
   qos.name(name);
+  applyReceiveTuning(receive, &qos);
   applySecurity(security, &qos);
   participant_ = factory->create_participant(domain_id_, qos);
   if (!participant_)

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "services/runtime/dds_security.hpp"
+#include "services/runtime/polling_udp_transport.hpp"
 
 namespace mft::services {
 
@@ -31,8 +32,9 @@ class DdsParticipant {
   // Loads `profiles_file` (throws if it is missing or malformed) and creates a participant with the
   // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery. With `security`
   // enabled the participant authenticates with that identity (docs/security.md).
+  // `receive` tunes the receive path (socket buffer, polling; polling_udp_transport.hpp).
   DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
-                 const SecurityOptions& security = {});
+                 const SecurityOptions& security = {}, const ReceiveTuning& receive = {});
   ~DdsParticipant();
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;

@@ -32,6 +32,8 @@ def run_stack(args, tmp, scenario, mode, record=False, tag=""):
            "--json", "--run-dir", str(run_dir), "--bin-dir", str(args.bin_dir)]
     if record:
         cmd += ["--record", str(Path(tmp) / f"{tag}.rawlog")]
+    if args.chain_cpu is not None:
+        cmd += ["--chain-cpu", str(args.chain_cpu)]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.realtime_s + 300)
     try:
         summary = json.loads(p.stdout)
@@ -50,6 +52,8 @@ def main():
     ap.add_argument("--domain", type=int, default=71, help="DDS domain id for the runs (default 71)")
     ap.add_argument("--runs", type=int, default=3, help="lockstep runs with and without recording (default 3)")
     ap.add_argument("--realtime-s", type=float, default=60.0, help="length of the realtime run [s] (default 60)")
+    ap.add_argument("--chain-cpu", type=int, metavar="N", help="pass --chain-cpu N to the supervisor (chain on CPU N, "
+                    "recorder on the others)")
     ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = ap.parse_args()
@@ -58,7 +62,7 @@ def main():
     if args.runs < 1 or args.realtime_s < 1:
         sys.exit("measure-stack: --runs and --realtime-s must be at least 1")
 
-    out = {"cpus": os.cpu_count(), "load_per_core_before": round(os.getloadavg()[0] / (os.cpu_count() or 1), 2)}
+    out = {"cpus": os.cpu_count(), "chain_cpu": args.chain_cpu, "load_per_core_before": round(os.getloadavg()[0] / (os.cpu_count() or 1), 2)}
     with tempfile.TemporaryDirectory(prefix="mft-measure-") as tmp:
         plain, recorded = [], []
         for i in range(args.runs):
@@ -81,6 +85,8 @@ def main():
             "recording_real_time_factor_median": round(sim_s / statistics.median(wall_rec), 2),
             "recording_slowdown_median": round(statistics.median(wall_rec) / statistics.median(wall_plain), 3),
             "recording_slowdown_best": round(min(wall_rec) / min(wall_plain), 3),
+            # Each recorded run against the plain run just before it: the machine's drift cancels.
+            "recording_slowdown_paired": sorted(round(r / p, 3) for r, p in zip(wall_rec, wall_plain)),
             "resends": sum(s.get("lockstep_resends", 0) for s in plain + recorded),
         }
         if not args.skip_realtime:
@@ -104,7 +110,8 @@ def main():
           f"median -> {ls['real_time_factor_median']}x real time (best {ls['real_time_factor_best']}x)")
     print(f"  recording every topic: {statistics.median(ls['wall_s_recording']):.3f} s median -> "
           f"{ls['recording_real_time_factor_median']}x real time, slowdown x{ls['recording_slowdown_median']} "
-          f"(best x{ls['recording_slowdown_best']}); tick re-sends {ls['resends']}")
+          f"(best x{ls['recording_slowdown_best']}, paired median x{statistics.median(ls['recording_slowdown_paired']):.3f}); "
+          f"tick re-sends {ls['resends']}")
     if "realtime" in out:
         rt = out["realtime"]
         lat = rt["sensor_to_command_latency_us"]

@@ -145,11 +145,36 @@ class SupervisorTest(unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("no stack is up on domain 11", r.stderr)
 
+    def test_chain_cpu_pins_the_chain_and_gives_the_recorder_the_other_cpus(self):
+        allowed = sorted(os.sched_getaffinity(0))
+        chain_cpu = allowed[-1]
+        env = dict(self.env, FAKE_SERVICES="")
+        base = [sys.executable, str(SUPERVISOR)]
+        opts = ["--bin-dir", str(self.bin), "--config-dir", str(self.cfg)]
+        r = subprocess.run(base + ["up", str(self.scenario), "--domain", "13", "--chain-cpu", str(chain_cpu),
+                                   "--record", str(self.tmp / "x.rawlog")] + opts,
+                           env=env, capture_output=True, text=True, timeout=60)
+        try:
+            self.assertEqual(r.returncode, 0, r.stderr)
+            started = {l.split()[0]: int(l.split()[1]) for l in self.pid_log.read_text().splitlines()}
+            self.assertEqual(set(started), set(SERVICES))
+            for name, pid in started.items():
+                cpus = os.sched_getaffinity(pid)
+                if name == "mft-record":
+                    expect = set(allowed) - {chain_cpu} or {chain_cpu}
+                    self.assertEqual(cpus, expect, name)
+                else:
+                    self.assertEqual(cpus, {chain_cpu}, name)
+        finally:
+            subprocess.run(base + ["down", "--domain", "13"], env=env, capture_output=True, text=True, timeout=60)
+        self.assertFalse(any(pid_alive(p) for p in self.started_pids()))
+
     def test_bad_inputs_start_nothing(self):
         cases = [
             (["run", str(self.scenario), "--domain", "500"], "bad domain id 500"),
             (["run", str(self.tmp / "missing.yaml"), "--domain", "12"], "does not exist"),
             (["run", str(self.scenario), "--domain", "12", "--mode", "fast"], "bad mode 'fast'"),
+            (["run", str(self.scenario), "--domain", "12", "--chain-cpu", "4096"], "--chain-cpu 4096: this process may run"),
         ]
         for args, expect in cases:
             code, out, err = self.supervisor(*args)

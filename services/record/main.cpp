@@ -103,11 +103,13 @@ std::string threadCpuJson() {
 // How the recorder's DDS-side threads (all but the writer) give way to the stack once the topics flow.
 enum class Background { kNone, kNice, kIdle };
 
-void setBackground(Background how, long nice_value, int except_tid) {
+// The writer thread and the main thread (housekeeping every 5 ms, and the starvation guard below) keep theirs.
+void setBackground(Background how, long nice_value, int writer_tid) {
+  const int main_tid = static_cast<int>(getpid());
   std::error_code ec;
   for (const auto& e : fs::directory_iterator("/proc/self/task", ec)) {
     const int tid = std::atoi(e.path().filename().c_str());
-    if (tid <= 0 || tid == except_tid) continue;
+    if (tid <= 0 || tid == writer_tid || tid == main_tid) continue;
     sched_param none{};
     sched_setscheduler(tid, how == Background::kIdle ? SCHED_IDLE : SCHED_OTHER, &none);
     setpriority(PRIO_PROCESS, static_cast<id_t>(tid), how == Background::kNice ? static_cast<int>(nice_value) : 0);
@@ -137,10 +139,11 @@ int firstPiece(const std::string& output) {
 namespace dds = eprosima::fastdds::dds;
 
 // What the polling receive path did (all zero with --poll-us 0).
-std::string pollJson() {
+std::string pollJson(int starvation_fallbacks) {
   const auto& st = services::PollingUdpTransport::lastStats();
   return "\"receive_polls\": " + std::to_string(st.polls.load()) + ", \"polled_datagrams\": " +
-         std::to_string(st.datagrams.load()) + ", \"max_datagrams_per_poll\": " + std::to_string(st.max_datagrams_per_poll.load());
+         std::to_string(st.datagrams.load()) + ", \"max_datagrams_per_poll\": " + std::to_string(st.max_datagrams_per_poll.load()) +
+         ", \"idle_starvation_fallbacks\": " + std::to_string(starvation_fallbacks);
 }
 
 // The recorder's own participant: the project's "mft_participant" profile with larger socket buffers. It
@@ -347,6 +350,7 @@ int main(int argc, char** argv) {
     cli.fail(e.what());
   }
   std::string cpu_json;
+  int starvation_fallbacks = 0;
   {
     // The writers of the 1 kHz chain offer best effort in both modes (lockstep recovers a lost sample by
     // re-sending the tick, docs/recording.md); a reader asking for more would not match. Losses show as
@@ -401,11 +405,23 @@ int main(int argc, char** argv) {
     // ticks still waiting in a niced recorder's socket buffer would be discarded.
     const auto end_ns = static_cast<std::uint64_t>(std::max(0.0, scenario.duration_s - 0.5) * 1e9);
     bool near_end = false;
+    const bool polling = cli.getInt("poll-us", 0, 100000) > 0;
     while (!services::shutdownRequested()) {
       publishProgress();
       if (!reniced && flowing()) {
         setBackground(background, nice_value, recorder.writerThreadId());
         reniced = true;
+      }
+      // SCHED_IDLE gets next to nothing while other work keeps every CPU busy (a parallel test run, a sweep):
+      // the simulator would then wait on its window until it times out. A receive thread that has not
+      // polled for 50 ms falls back to nice, as in realtime, for the rest of the run.
+      if (reniced && background == Background::kIdle && !near_end && polling &&
+          services::PollingUdpTransport::lastStats().sincePollNs() > 50'000'000) {
+        background = Background::kNice;
+        setBackground(background, nice_value, recorder.writerThreadId());
+        ++starvation_fallbacks;
+        std::printf("mft-record: the receive thread was starved at SCHED_IDLE: nice %ld from now on\n", nice_value);
+        std::fflush(stdout);
       }
       if (reniced && background != Background::kNone && !near_end && recorder.newestStampNs() >= end_ns) {
         setBackground(Background::kNone, 0, recorder.writerThreadId());
@@ -433,7 +449,7 @@ int main(int argc, char** argv) {
               static_cast<double>(s.compressed_bytes) / 1e6, s.pieces.size(), s.pieces.empty() ? "" : s.pieces.front().c_str());
   writeSummary(cli.get("summary"), "{\"service\": \"mft-record\", \"file\": \"" + opt.output + "\", \"mode\": \"" +
                                       md.mode + "\", \"cpu_s\": " + cpu_json + ", " +
-                                      pollJson() + ", " +
+                                      pollJson(starvation_fallbacks) + ", " +
                                       recorder.summaryJson() + "}");
   return s.error.empty() ? 0 : 1;
 }

@@ -88,6 +88,19 @@ PollingUdpTransport::~PollingUdpTransport() {
   channels_.clear();
 }
 
+namespace {
+std::int64_t monotonicNs() {
+  timespec t{};
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1000000000LL + t.tv_nsec;
+}
+}  // namespace
+
+std::int64_t PollingUdpStats::sincePollNs() const {
+  const std::int64_t last = last_poll_ns.load(std::memory_order_relaxed);
+  return last == 0 ? 0 : monotonicNs() - last;
+}
+
 const PollingUdpStats& PollingUdpTransport::lastStats() { return *lastStatsSlot(); }
 
 std::vector<std::string> PollingUdpTransport::bindAddresses(const rtps::Locator_t& locator) const {
@@ -185,6 +198,7 @@ void PollingUdpTransport::pollLoop() {
       }
     }
     stats_->polls.fetch_add(1, std::memory_order_relaxed);
+    stats_->last_poll_ns.store(monotonicNs(), std::memory_order_relaxed);
     stats_->datagrams.fetch_add(n, std::memory_order_relaxed);
     if (n > stats_->max_datagrams_per_poll.load(std::memory_order_relaxed))
       stats_->max_datagrams_per_poll.store(n, std::memory_order_relaxed);

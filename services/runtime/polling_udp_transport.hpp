@@ -39,6 +39,9 @@ struct PollingUdpStats {
   std::atomic<std::uint64_t> polls{0};
   std::atomic<std::uint64_t> datagrams{0};
   std::atomic<std::uint64_t> max_datagrams_per_poll{0};
+  std::atomic<std::int64_t> last_poll_ns{0};  // CLOCK_MONOTONIC
+  // How long ago the receive thread last polled (a starved thread shows here).
+  std::int64_t sincePollNs() const;
 };
 
 class PollingUdpTransport : public eprosima::fastdds::rtps::ChainingTransport {

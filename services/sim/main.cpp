@@ -17,6 +17,7 @@
 #include "MftMsgsPubSubTypes.h"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/command_watchdog.hpp"
+#include "services/runtime/stall_probe.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/input_guard.hpp"
 #include "services/runtime/latency_stats.hpp"
@@ -82,6 +83,9 @@ int main(int argc, char** argv) {
   cli.option("resend-ms", "lockstep: re-send a tick whose JointCommand is this late [ms]", "20");
   cli.option("start-timeout", "seconds to wait for the controller chain to connect and answer", "30");
   cli.option("watchdog-ms", "realtime: command timeout before the actuators damp [ms]", "3");
+  cli.option("stall-probe-us", "realtime: period of the CPU stall probe (one SCHED_FIFO thread per CPU that tells\n"
+             "                             the machine's stalls from the chain's misses; costs ~30 us of p50 latency\n"
+             "                             on a 2-vCPU VM; 0 = off) [us]", "0");
   cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
   cli.option("recorder-window", "lockstep: never run more than this many ticks ahead of mft-record's progress "
                                 "(0 = no recorder flow control; the supervisor sets it when recording)", "0");
@@ -132,6 +136,10 @@ int main(int argc, char** argv) {
   std::array<double, 8> recent_late_us{};        // its lateness over the last 8 periods
   std::size_t recent_index = 0;
   std::uint64_t sim_stalls = 0;                  // simulator wake-ups later than the watchdog timeout
+  // Per counted miss, the deadline it missed: judged after the run against the CPU stall probe (a stall
+  // still going on at detection is recorded only when it ends).
+  std::vector<std::int64_t> missed_deadlines_ns;
+  missed_deadlines_ns.reserve(256);
   const bool quiet = cli.isSet("quiet");
   const double max_push_Ns = cli.getDouble("max-push", 0.0, 1e4);
   const double peak_torque = ctx.robot().actuator.outputPeakTorque();
@@ -275,6 +283,14 @@ int main(int argc, char** argv) {
     std::printf("mft-sim: the chain answered tick 0: the clock starts\n");  // the supervisor's `up` waits for it
     std::fflush(stdout);
   }
+  std::unique_ptr<services::StallProbe> stall_probe;
+  const auto stall_probe_us = cli.getInt("stall-probe-us", 0, 100000);
+  if (!ctx.lockstep() && stall_probe_us > 0) {
+    services::StallProbe::Options o;
+    o.period = std::chrono::microseconds(stall_probe_us);
+    o.threshold = std::chrono::microseconds(std::max<long>(stall_probe_us, 1000));
+    stall_probe = std::make_unique<services::StallProbe>(o);
+  }
   auto wall_start = Clock::now();
   auto next_wakeup = wall_start;
   double start_wait_s = 0;  // lockstep: until the chain (and the recorder) answered tick 0; not loop time
@@ -361,6 +377,8 @@ int main(int argc, char** argv) {
       // One entry per counted miss (a recovery and a new miss between two periods count as two).
       if (watchdog.deadlineMisses() > misses_before && onset_sim_late_ms.size() < 64)
         onset_sim_late_ms.push_back(*std::max_element(recent_late_us.begin(), recent_late_us.end()) * 1e-3);
+      if (watchdog.deadlineMisses() > misses_before && missed_deadlines_ns.size() < missed_deadlines_ns.capacity())
+        missed_deadlines_ns.push_back(watchdog.missedDeadlineNs());
       if (damping_now && !was_damping) {
         // How long after the deadline (the waiting tick's publication + timeout) the actuators went into damping.
         const double late_ms = static_cast<double>(watchdog.dampingSinceNs() - watchdog.missedDeadlineNs()) * 1e-6;
@@ -474,9 +492,37 @@ int main(int argc, char** argv) {
     episode_json += e;
   }
   episode_json += "]";
+  // A miss is the machine's when some CPU stood still for at least half the timeout while the tick waited:
+  // the chain's p99 is under 0.5 ms, so a chain that misses 3 ms needs a stall of that order (or is itself
+  // too slow, which the damping totals show). The window is widened by one probe period on each side: a
+  // stall is recorded from the first probe wake-up it delayed, up to one period after it began.
+  std::string probe_json;
+  if (stall_probe) {
+    std::uint64_t explained = 0;
+    const std::int64_t probe_period_ns = stall_probe_us * 1000;
+    std::string per_miss = "[";
+    for (const std::int64_t deadline : missed_deadlines_ns) {
+      const std::int64_t from = deadline - watchdog_timeout_ns - probe_period_ns;
+      const std::int64_t stalled = stall_probe->stalledWithinNs(from, deadline + probe_period_ns);
+      if (stalled * 2 >= watchdog_timeout_ns) ++explained;
+      char e[32];
+      std::snprintf(e, sizeof e, "%s%.3f", per_miss.size() > 1 ? ", " : "", static_cast<double>(stalled) * 1e-6);
+      per_miss += e;
+    }
+    per_miss += "]";
+    const std::uint64_t misses = watchdog.deadlineMisses();
+    char pj[400];
+    std::snprintf(pj, sizeof pj,
+                  ", \"cpu_stalls\": {\"probe_cpus\": %d, \"fifo\": %s, \"count\": %llu, \"max_ms\": %.3f, \"total_ms\": %.3f}, "
+                  "\"deadline_misses_during_cpu_stalls\": %llu, \"deadline_misses_unexplained\": %llu, \"miss_cpu_stalled_ms\": ",
+                  stall_probe->cpus(), stall_probe->realtimePriority() ? "true" : "false",
+                  static_cast<unsigned long long>(stall_probe->stalls()), stall_probe->maxStallMs(), stall_probe->totalStallMs(),
+                  static_cast<unsigned long long>(explained), static_cast<unsigned long long>(misses - explained));
+    probe_json = std::string(pj) + per_miss;
+  }
   ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
                    ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
-                   std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + "}");
+                   std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + probe_json + "}");
   return exit_code;
 }

@@ -83,7 +83,7 @@ class StackTest(unittest.TestCase):
         self.assertLess(abs(sim["average_speed_mps"]), 0.05)
 
     def test_realtime_steps_in_place(self):
-        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime")
+        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime", "--stall-probe")
         self.assertEqual(code, 0, err[-3000:])
         sim = s["services"]["mft-sim"]
         self.assertFalse(s["fell"], sim.get("fall_reason"))
@@ -92,8 +92,14 @@ class StackTest(unittest.TestCase):
         self.assertGreater(sim["latency_us"]["count"], 9000)  # nearly every command answered within its period
         print(f"\nrealtime: deadline misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, "
               f"latency p50 {sim['latency_us']['p50']:.0f} us p99 {sim['latency_us']['p99']:.0f} us, simulator "
-              f"stalls {sim['sim_stalls']}, its worst lateness before each miss {sim['damping_onset_sim_late_ms']} ms",
+              f"stalls {sim['sim_stalls']}, its worst lateness before each miss {sim['damping_onset_sim_late_ms']} ms; "
+              f"CPU stalls {sim['cpu_stalls']}, misses during them {sim['deadline_misses_during_cpu_stalls']}, "
+              f"unexplained {sim['deadline_misses_unexplained']} (stalled ms per miss {sim['miss_cpu_stalled_ms']})",
               file=sys.stderr)
+        # The stall probe ran on every CPU of the stack and judged every miss it kept.
+        self.assertEqual(sim["cpu_stalls"]["probe_cpus"], len(os.sched_getaffinity(0)))
+        self.assertEqual(len(sim["miss_cpu_stalled_ms"]), min(sim["deadline_misses"], 256))
+        self.assertEqual(sim["deadline_misses_during_cpu_stalls"] + sim["deadline_misses_unexplained"], sim["deadline_misses"])
         # Deadline misses. On this 2-vCPU VM an idle machine gives 0 in most 10 s runs, but the hypervisor's
         # steal comes in bursts (one CI run: 8 misses with 8 simulator stalls; another: a 6.5 ms stall and an
         # 8 ms damping episode; a stall of only the controller's vCPU cannot be told from the chain's). The

@@ -1,0 +1,53 @@
+#pragma once
+// Tells the machine's stalls from the control chain's: one thread per CPU of the process, pinned to it at
+// the highest SCHED_FIFO priority it may take, wakes every `period` and records every wake-up later than
+// `threshold` as a stall [scheduled, woke). Nothing of ours can delay such a thread by milliseconds on an
+// idle machine; a hypervisor descheduling the vCPU can (this VM: 3-30 ms bursts). The simulator asks, for
+// each deadline miss, how long any CPU was stalled while the tick waited. No allocation after start.
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace mft::services {
+
+class StallProbe {
+ public:
+  struct Options {
+    std::chrono::microseconds period{1000};
+    std::chrono::microseconds threshold{1000};
+    std::size_t capacity = 1024;  // stalls kept (the oldest go first)
+  };
+  explicit StallProbe(const Options& options);
+  ~StallProbe();
+  StallProbe(const StallProbe&) = delete;
+  StallProbe& operator=(const StallProbe&) = delete;
+
+  // Time [ns] within [t0_ns, t1_ns] (steady_clock) during which at least one CPU was stalled.
+  std::int64_t stalledWithinNs(std::int64_t t0_ns, std::int64_t t1_ns) const;
+  std::uint64_t stalls() const;
+  double maxStallMs() const;
+  double totalStallMs() const;
+  int cpus() const { return static_cast<int>(threads_.size()); }
+  bool realtimePriority() const { return realtime_priority_; }
+
+  // For tests: record a stall as a probe thread would.
+  void recordStall(std::int64_t from_ns, std::int64_t to_ns);
+
+ private:
+  void run(int cpu);
+
+  Options options_;
+  mutable std::mutex mutex_;
+  std::vector<std::pair<std::int64_t, std::int64_t>> ring_;  // preallocated, `capacity` entries
+  std::size_t next_ = 0, count_ = 0;
+  std::uint64_t stalls_ = 0;
+  std::int64_t max_stall_ns_ = 0, total_stall_ns_ = 0;
+  bool stop_ = false;
+  bool realtime_priority_ = true;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace mft::services

@@ -1,0 +1,90 @@
+// The CPU stall probe (services/runtime/stall_probe.hpp): the union of stalls within a window, the ring
+// keeping the newest, one thread per CPU, and a real stall (the process stopped by SIGSTOP) recorded.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "services/runtime/stall_probe.hpp"
+
+using mft::services::StallProbe;
+
+namespace {
+StallProbe::Options idleProbe() {
+  StallProbe::Options o;
+  o.period = std::chrono::microseconds(100000);  // the live threads stay out of the way of these tests
+  o.threshold = std::chrono::microseconds(50000000);
+  o.capacity = 4;
+  return o;
+}
+}  // namespace
+
+TEST(StallProbe, StalledTimeIsTheUnionOfTheStallsInTheWindow) {
+  StallProbe probe(idleProbe());
+  probe.recordStall(10, 20);
+  probe.recordStall(15, 30);  // overlaps the first (two CPUs stalled at once count once)
+  probe.recordStall(50, 60);
+  EXPECT_EQ(probe.stalledWithinNs(0, 100), 30);
+  EXPECT_EQ(probe.stalledWithinNs(18, 55), 12 + 5);
+  EXPECT_EQ(probe.stalledWithinNs(30, 50), 0);
+  EXPECT_EQ(probe.stalledWithinNs(60, 10), 0);
+  EXPECT_EQ(probe.stalls(), 3u);
+  EXPECT_DOUBLE_EQ(probe.maxStallMs(), 15e-6);
+  EXPECT_DOUBLE_EQ(probe.totalStallMs(), 35e-6);
+}
+
+TEST(StallProbe, KeepsTheNewestStallsWhenFull) {
+  StallProbe probe(idleProbe());  // capacity 4
+  for (int i = 0; i < 6; ++i) probe.recordStall(100 * i, 100 * i + 10);
+  EXPECT_EQ(probe.stalledWithinNs(0, 200), 0);        // the two oldest are gone
+  EXPECT_EQ(probe.stalledWithinNs(200, 600), 40);
+  EXPECT_EQ(probe.stalls(), 6u);                      // but counted
+}
+
+TEST(StallProbe, OneThreadPerCpuOfTheProcess) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  ASSERT_EQ(sched_getaffinity(0, sizeof set, &set), 0);
+  StallProbe probe(idleProbe());
+  EXPECT_EQ(probe.cpus(), CPU_COUNT(&set));
+}
+
+// A child runs a probe (1 ms period, 5 ms threshold) and is stopped for 40 ms: every CPU's thread wakes at
+// least ~35 ms late. It reports its stalls through a pipe.
+TEST(StallProbe, RecordsTheProcessBeingStopped) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    close(fds[0]);
+    double result[2] = {0, 0};
+    {
+      StallProbe::Options o;
+      o.period = std::chrono::microseconds(1000);
+      o.threshold = std::chrono::microseconds(5000);
+      StallProbe probe(o);
+      std::this_thread::sleep_for(std::chrono::milliseconds(400));
+      result[0] = static_cast<double>(probe.stalls());
+      result[1] = probe.maxStallMs();
+    }
+    if (write(fds[1], result, sizeof result) != sizeof result) _exit(2);
+    _exit(0);
+  }
+  close(fds[1]);
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  kill(child, SIGSTOP);
+  std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  kill(child, SIGCONT);
+  double result[2] = {0, 0};
+  const ssize_t got = read(fds[0], result, sizeof result);
+  int status = 0;
+  waitpid(child, &status, 0);
+  close(fds[0]);
+  ASSERT_EQ(got, static_cast<ssize_t>(sizeof result));
+  EXPECT_GE(result[0], 1.0);
+  EXPECT_GE(result[1], 30.0);
+}

@@ -75,7 +75,7 @@ PollingUdpTransportDescriptor::PollingUdpTransportDescriptor(std::shared_ptr<fdd
 fdds::TransportInterface* PollingUdpTransportDescriptor::create_transport() const { return new PollingUdpTransport(*this); }
 
 PollingUdpTransport::PollingUdpTransport(const PollingUdpTransportDescriptor& d)
-    : ChainingTransport(d), descriptor_(d), udp_(d.udp), period_(d.poll_period), stats_(std::make_shared<PollingUdpStats>()) {
+    : ChainingTransport(d), descriptor_(d), stats_(std::make_shared<PollingUdpStats>()) {
   lastStatsSlot() = stats_;
   thread_ = std::thread([this] { pollLoop(); });
 }
@@ -105,9 +105,9 @@ const PollingUdpStats& PollingUdpTransport::lastStats() { return *lastStatsSlot(
 
 std::vector<std::string> PollingUdpTransport::bindAddresses(const rtps::Locator_t& locator) const {
   if (!IPLocator::isAny(locator)) return {IPLocator::toIPv4string(locator)};
-  if (udp_->interfaceWhiteList.empty()) return {"0.0.0.0"};
+  if (descriptor_.udp->interfaceWhiteList.empty()) return {"0.0.0.0"};
   std::vector<std::string> out;
-  for (const std::string& entry : udp_->interfaceWhiteList)
+  for (const std::string& entry : descriptor_.udp->interfaceWhiteList)
     for (const std::string& a : resolveInterface(entry)) out.push_back(a);
   return out;
 }
@@ -121,7 +121,7 @@ bool PollingUdpTransport::OpenInputChannel(const rtps::Locator_t& locator, fdds:
   if (addresses.empty()) return false;
   std::vector<Channel> opened;
   for (const std::string& address : addresses) {
-    const int fd = openBoundSocket(address, port, udp_->receiveBufferSize);
+    const int fd = openBoundSocket(address, port, descriptor_.udp->receiveBufferSize);
     if (fd < 0) {
       for (const Channel& c : opened) ::close(c.fd);
       return false;
@@ -205,7 +205,7 @@ void PollingUdpTransport::pollLoop() {
     // An absolute schedule that never tries to catch up: after a long stall, poll again one period later.
     timespec now{};
     clock_gettime(CLOCK_MONOTONIC, &now);
-    next.tv_nsec += static_cast<long>(period_.count()) * 1000;
+    next.tv_nsec += static_cast<long>(descriptor_.poll_period.count()) * 1000;
     while (next.tv_nsec >= 1000000000L) {
       next.tv_nsec -= 1000000000L;
       ++next.tv_sec;

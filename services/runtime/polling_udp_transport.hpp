@@ -79,9 +79,7 @@ class PollingUdpTransport : public eprosima::fastdds::rtps::ChainingTransport {
   void pollLoop();
   std::vector<std::string> bindAddresses(const eprosima::fastrtps::rtps::Locator_t& locator) const;
 
-  PollingUdpTransportDescriptor descriptor_;
-  std::shared_ptr<eprosima::fastdds::rtps::UDPv4TransportDescriptor> udp_;
-  std::chrono::microseconds period_;
+  PollingUdpTransportDescriptor descriptor_;  // its udp and poll_period configure everything below
   mutable std::mutex mutex_;  // held while delivering: a closed channel gets nothing after Close returns
   std::vector<Channel> channels_;
   std::atomic<bool> stop_{false};

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 
 namespace mft::services {
 
@@ -25,10 +24,7 @@ StallProbe::StallProbe(const Options& options) : options_(options), ring_(std::m
 }
 
 StallProbe::~StallProbe() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
-  }
+  stop_ = true;
   for (auto& t : threads_) t.join();
 }
 
@@ -46,11 +42,7 @@ void StallProbe::run(int cpu) {
   const std::int64_t period_ns = options_.period.count() * 1000;
   const std::int64_t threshold_ns = options_.threshold.count() * 1000;
   std::int64_t next = steadyNs();
-  for (;;) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (stop_) return;
-    }
+  while (!stop_) {
     next += period_ns;
     timespec ts{static_cast<time_t>(next / 1000000000LL), static_cast<long>(next % 1000000000LL)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);  // steady_clock is CLOCK_MONOTONIC here
@@ -93,6 +85,11 @@ std::int64_t StallProbe::stalledWithinNs(std::int64_t t0, std::int64_t t1) const
     }
   }
   return total;
+}
+
+std::int64_t StallProbe::stalledWhileWaitingNs(std::int64_t deadline_ns, std::int64_t timeout_ns) const {
+  const std::int64_t period_ns = options_.period.count() * 1000;
+  return stalledWithinNs(deadline_ns - timeout_ns - period_ns, deadline_ns + period_ns);
 }
 
 std::uint64_t StallProbe::stalls() const {

@@ -4,6 +4,7 @@
 // `threshold` as a stall [scheduled, woke). Nothing of ours can delay such a thread by milliseconds on an
 // idle machine; a hypervisor descheduling the vCPU can (this VM: 3-30 ms bursts). The simulator asks, for
 // each deadline miss, how long any CPU was stalled while the tick waited. No allocation after start.
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -27,6 +28,14 @@ class StallProbe {
 
   // Time [ns] within [t0_ns, t1_ns] (steady_clock) during which at least one CPU was stalled.
   std::int64_t stalledWithinNs(std::int64_t t0_ns, std::int64_t t1_ns) const;
+  // How long some CPU stood still while a tick waited for its command until `deadline_ns` (published
+  // `timeout_ns` before it). The window is widened by one probe period on each side: a stall is recorded
+  // from the first probe wake-up it delayed, up to one period after it began.
+  std::int64_t stalledWhileWaitingNs(std::int64_t deadline_ns, std::int64_t timeout_ns) const;
+  // A miss is the machine's when some CPU stood still for at least half the timeout while the tick waited:
+  // the chain's p99 is under 0.5 ms, so missing 3 ms takes a stall of that order (or a chain too slow on
+  // every tick, which the damping totals show).
+  static bool explainsMiss(std::int64_t stalled_ns, std::int64_t timeout_ns) { return stalled_ns * 2 >= timeout_ns; }
   std::uint64_t stalls() const;
   double maxStallMs() const;
   double totalStallMs() const;
@@ -45,7 +54,7 @@ class StallProbe {
   std::size_t next_ = 0, count_ = 0;
   std::uint64_t stalls_ = 0;
   std::int64_t max_stall_ns_ = 0, total_stall_ns_ = 0;
-  bool stop_ = false;
+  std::atomic<bool> stop_{false};
   bool realtime_priority_ = true;
   std::vector<std::thread> threads_;
 };

@@ -492,19 +492,14 @@ int main(int argc, char** argv) {
     episode_json += e;
   }
   episode_json += "]";
-  // A miss is the machine's when some CPU stood still for at least half the timeout while the tick waited:
-  // the chain's p99 is under 0.5 ms, so a chain that misses 3 ms needs a stall of that order (or is itself
-  // too slow, which the damping totals show). The window is widened by one probe period on each side: a
-  // stall is recorded from the first probe wake-up it delayed, up to one period after it began.
+  // Each miss judged against the machine's stalls (services/runtime/stall_probe.hpp).
   std::string probe_json;
   if (stall_probe) {
     std::uint64_t explained = 0;
-    const std::int64_t probe_period_ns = stall_probe_us * 1000;
     std::string per_miss = "[";
     for (const std::int64_t deadline : missed_deadlines_ns) {
-      const std::int64_t from = deadline - watchdog_timeout_ns - probe_period_ns;
-      const std::int64_t stalled = stall_probe->stalledWithinNs(from, deadline + probe_period_ns);
-      if (stalled * 2 >= watchdog_timeout_ns) ++explained;
+      const std::int64_t stalled = stall_probe->stalledWhileWaitingNs(deadline, watchdog_timeout_ns);
+      if (services::StallProbe::explainsMiss(stalled, watchdog_timeout_ns)) ++explained;
       char e[32];
       std::snprintf(e, sizeof e, "%s%.3f", per_miss.size() > 1 ? ", " : "", static_cast<double>(stalled) * 1e-6);
       per_miss += e;

@@ -36,6 +36,17 @@ TEST(StallProbe, StalledTimeIsTheUnionOfTheStallsInTheWindow) {
   EXPECT_DOUBLE_EQ(probe.totalStallMs(), 35e-6);
 }
 
+TEST(StallProbe, JudgesAMissByTheStallsWhileTheTickWaited) {
+  StallProbe probe(idleProbe());  // period 100 ms: the window reaches one period past each end
+  const std::int64_t ms = 1000000, period = 100 * ms, timeout = 3 * ms, deadline = 1000 * ms;
+  probe.recordStall(deadline - timeout - period - 5 * ms, deadline - timeout - period - 1 * ms);  // before: not counted
+  EXPECT_EQ(probe.stalledWhileWaitingNs(deadline, timeout), 0);
+  probe.recordStall(deadline + period - ms, deadline + period + 9 * ms);  // recorded up to a period late
+  EXPECT_EQ(probe.stalledWhileWaitingNs(deadline, timeout), ms);
+  EXPECT_FALSE(StallProbe::explainsMiss(ms, timeout));
+  EXPECT_TRUE(StallProbe::explainsMiss(timeout / 2, timeout));
+}
+
 TEST(StallProbe, KeepsTheNewestStallsWhenFull) {
   StallProbe probe(idleProbe());  // capacity 4
   for (int i = 0; i < 6; ++i) probe.recordStall(100 * i, 100 * i + 10);

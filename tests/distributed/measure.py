@@ -25,12 +25,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
-HOSTS = ["robot", "ctrl", "aux"]
-PLACEMENT = {"mft-sim": "robot", "mft-wbc": "ctrl", "mft-estimator": "aux", "mft-planner": "aux", "mft-record": "aux"}
+from stack_layout import BIN, HOSTS, PLACEMENT, SCENARIOS, SUPERVISOR  # noqa: E402
 
 
 class Harness:

@@ -1,11 +1,10 @@
 """case: one push at one height with each controller (recorded), and the paper's Fig. 6 as a PNG."""
-import json
 import threading
 import time
 from pathlib import Path
 
 from .common import (CONTROLLER_NAMES, REPO, REGISTRY, ExperimentError, Interrupted, check_scenario, export_csv, log,
-                     pyplot, read_csv, run_scenario)
+                     pyplot, read_csv, run_scenario, run_workers, write_report)
 from . import push as pushmod
 
 COLORS = {"mft": "tab:blue", "sa": "tab:orange", "none": "tab:gray"}
@@ -46,18 +45,7 @@ def run_pair(args, jobs):
                 REGISTRY.stop_all()
                 return
 
-    threads = [threading.Thread(target=worker, args=(i,), daemon=True) for i in range(max(1, args.workers))]
-    for t in threads:
-        t.start()
-    try:
-        while any(t.is_alive() for t in threads):
-            for t in threads:
-                t.join(timeout=0.2)
-    except KeyboardInterrupt:
-        REGISTRY.stop_all()
-        raise Interrupted()
-    if errors:
-        raise errors[0] if isinstance(errors[0], ExperimentError) else ExperimentError(str(errors[0]))
+    run_workers(worker, args.workers, errors)
     if REGISTRY.stopping.is_set():
         raise Interrupted()
     return results
@@ -95,12 +83,8 @@ def cmd_case(args, setup):
             "after": rec.get("after"), "tail": rec.get("tail"), "rawlog": str(out / f"{c}.rawlog"),
             "wall_s": round(wall, 2)}
     png = plot_case(out / "case.png", args, setup, report, traces)
-    report["plot"] = str(png)
-    report["wall_s"] = round(time.monotonic() - t0, 1)
-    (out / "case.json").write_text(json.dumps(report, indent=1) + "\n")
-    if args.json:
-        print(json.dumps(report, indent=1))
-    else:
+    write_report(out / "case.json", report, png, t0, args.json)
+    if not args.json:
         print(f"case: {args.impulse:g} N s {setup.direction} at {args.height:.2f} m ({setup.liftoff}-foot lift-off)")
         for c, r in report["controllers"].items():
             print(f"  {CONTROLLER_NAMES.get(c, c):8s} push at {r['push_time_s']:.3f} s: "

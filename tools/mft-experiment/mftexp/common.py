@@ -143,6 +143,39 @@ class ProcessRegistry:
 REGISTRY = ProcessRegistry()
 
 
+def run_workers(worker, count, errors, interrupted_msg=None):
+    """Runs worker(i) for i in 0..count-1 on threads and waits for them. Ctrl-C stops every run in flight and
+    raises Interrupted; the first error a worker appended to `errors` is raised as an ExperimentError."""
+    threads = [threading.Thread(target=worker, args=(i,), daemon=True) for i in range(max(1, count))]
+    for t in threads:
+        t.start()
+    try:
+        while any(t.is_alive() for t in threads):
+            for t in threads:
+                t.join(timeout=0.2)
+    except KeyboardInterrupt:
+        if interrupted_msg:
+            log(interrupted_msg)
+        REGISTRY.stop_all()
+        for t in threads:
+            t.join(timeout=30)
+        raise Interrupted()
+    if errors:
+        e = errors[0]
+        if isinstance(e, ExperimentError):
+            raise e
+        raise ExperimentError(f"a worker failed: {type(e).__name__}: {e}")
+
+
+def write_report(path, report, png, t0, as_json):
+    """Completes the report with its figure and wall time, writes it to `path` and prints it when `as_json`."""
+    report["plot"] = str(png)
+    report["wall_s"] = round(time.monotonic() - t0, 1)
+    path.write_text(json.dumps(report, indent=1) + "\n")
+    if as_json:
+        print(json.dumps(report, indent=1))
+
+
 def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=None, timeout_s=600.0):
     """One lockstep run through the supervisor. Returns (summary dict, wall seconds); raises ExperimentError
     when the stack itself failed (not when the robot fell) and Interrupted when stopping."""

@@ -19,7 +19,8 @@ import time
 from dataclasses import asdict
 from pathlib import Path
 
-from .common import (ExperimentError, Interrupted, Progress, REGISTRY, check_scenario, log, run_scenario, fmt_duration)
+from .common import (ExperimentError, Interrupted, Progress, REGISTRY, check_scenario, log, run_scenario, run_workers,
+                     fmt_duration)
 from . import push as pushmod
 
 CELL_ORDER_NOTE = "cells run on --workers stacks in parallel, each on its own DDS domain"
@@ -342,23 +343,7 @@ class Sweep:
                     REGISTRY.stop_all()
                     return
 
-        threads = [threading.Thread(target=worker, args=(i,), daemon=True) for i in range(self.args.workers)]
         t0 = time.monotonic()
-        for t in threads:
-            t.start()
-        try:
-            while any(t.is_alive() for t in threads):
-                for t in threads:
-                    t.join(timeout=0.2)
-        except KeyboardInterrupt:
-            log("interrupted: stopping the runs in flight (finished runs are kept in results.jsonl)")
-            REGISTRY.stop_all()
-            for t in threads:
-                t.join(timeout=30)
-            raise Interrupted()
-        if errors:
-            e = errors[0]
-            if isinstance(e, ExperimentError):
-                raise e
-            raise ExperimentError(f"a worker failed: {type(e).__name__}: {e}")
+        run_workers(worker, self.args.workers, errors,
+                    "interrupted: stopping the runs in flight (finished runs are kept in results.jsonl)")
         return time.monotonic() - t0

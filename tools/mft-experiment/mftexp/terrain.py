@@ -5,13 +5,12 @@ MFT convention (model/mft_polytope.hpp, config/mft_space.yaml): one polygon per 
 b_leg with unit-norm rows (rad); for the left leg q_rear = q8 and q_fore = q10, the same polygon as the right leg
 (the augmented A = blkdiag(A_leg, A_leg) over q_a = [q4, q6, q8, q10] that the WBC uses). The violation of a
 sample is max(A_leg q - b_leg) in rad: <= 0 inside."""
-import json
 import math
 import time
 from pathlib import Path
 
 from .common import (CONTROLLER_NAMES, REPO, ExperimentError, check_scenario, export_csv, pyplot, read_csv,
-                     write_yaml_scenario)
+                     write_report, write_yaml_scenario)
 from .case import COLORS, run_pair
 
 INSIDE_TOL_RAD = 0.01  # "stayed inside" allows the soft constraint's small predicted violations
@@ -145,12 +144,8 @@ def cmd_terrain(args):
             "average_speed_mps": sim.get("average_speed_mps"), "base_height_error_m": sim.get("base_height_error_m"),
             "left_stance_on_up_slope_mft": mft_check, "rawlog": str(out / f"{c}.rawlog"), "wall_s": round(wall, 1)}
     png = plot_terrain(out / "terrain.png", args, report, traces, segs, slopes, rows, b, verts)
-    report["plot"] = str(png)
-    report["wall_s"] = round(time.monotonic() - t0, 1)
-    (out / "terrain.json").write_text(json.dumps(report, indent=1) + "\n")
-    if args.json:
-        print(json.dumps(report, indent=1))
-    else:
+    write_report(out / "terrain.json", report, png, t0, args.json)
+    if not args.json:
         print(f"terrain {args.terrain}: walk {args.speed} m/s at {args.height} m, course ends at x = {course_end:.2f} m")
         for c, r in report["controllers"].items():
             m = r["left_stance_on_up_slope_mft"]

@@ -10,7 +10,7 @@
 # shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/security.md).
 # Permissions: each service may publish only its own topics; only the sim publishes SensorData/GroundTruth,
 # only the WBC JointCommand; the recorder subscribes to every topic and publishes only its RecorderProgress (lockstep flow control); cmd publishes
-# OperatorCommand and Disturbance only.
+# OperatorCommand and Disturbance only and reads the CommandVerdict the planner and the sim answer with.
 set -euo pipefail
 
 usage() {
@@ -67,9 +67,9 @@ IDENTITIES=(sim estimator planner wbc record cmd)
 ALL_TOPICS=(SensorData GroundTruth RobotState OperatorCommand Reference JointCommand WbcDiagnostics Disturbance)
 # Who may publish / subscribe what (ARCHITECTURE.md section 4; mft-cmd publishes operator commands and pushes).
 declare -A PUB=(
-  [sim]="SensorData GroundTruth"
+  [sim]="SensorData GroundTruth CommandVerdict"
   [estimator]="RobotState"
-  [planner]="Reference"
+  [planner]="Reference CommandVerdict"
   [wbc]="JointCommand WbcDiagnostics"
   [record]="RecorderProgress"
   [cmd]="OperatorCommand Disturbance"
@@ -80,7 +80,7 @@ declare -A SUB=(
   [planner]="RobotState OperatorCommand"
   [wbc]="RobotState Reference"
   [record]="${ALL_TOPICS[*]}"
-  [cmd]=""
+  [cmd]="CommandVerdict"
 )
 
 echo "make-security: test CA and ${#IDENTITIES[@]} identities in $DIR (profile $PROFILE, $DAYS days)"

@@ -326,7 +326,7 @@ void Simulator::physicsStep(int substep) {
                                                             : m.liftoff_flag[static_cast<std::size_t>(it->leg)];
     if (due && !options_.fix_torso) {
       dBodyAddForce(m.robot.torso, it->impulse_Ns.x() / h_, it->impulse_Ns.y() / h_, 0.0);
-      stats_.impulses.push_back({it->impulse_Ns, t0});
+      stats_.impulses.push_back({it->impulse_Ns, t0, it->id});
       it = m.pending.erase(it);
     } else {
       ++it;

@@ -49,11 +49,13 @@ struct ImpulseSpec {
   ImpulseTrigger trigger = ImpulseTrigger::AtTime;
   double time_s = 0.0;  // AtTime: the first physics step that starts at or after this time
   int leg = 0;          // AtLiftOff: the physics step after the next lift-off of this leg (0 right, 1 left)
+  std::uint64_t id = 0;  // the caller's tag, carried into AppliedImpulse (which request was applied when)
 };
 
 struct AppliedImpulse {
   Eigen::Vector2d impulse_Ns{0.0, 0.0};
   double time_s = 0.0;  // start of the physics step that carried it
+  std::uint64_t id = 0;  // ImpulseSpec::id
 };
 
 struct SimStats {

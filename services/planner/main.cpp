@@ -1,6 +1,9 @@
 // mft-planner: RobotState(k) -> the paper's motion planner -> Reference(k). Operator commands come from the
 // scenario (at simulated times) and from the OperatorCommand topic (mft-cmd); a rejected command is reported
-// and the last valid one stays in force.
+// and the last valid one stays in force. Every OperatorCommand is answered on CommandVerdict: rejected with the
+// reason on arrival, or scheduled on arrival and applied at the next tick the planner answers (before that
+// tick's plan, so it acts from a well-defined tick, named in the verdict; docs/operator-commands.md).
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
@@ -9,6 +12,7 @@
 #include "MftMsgsPubSubTypes.h"
 #include "model/config/strict_yaml.hpp"
 #include "planner/motion_planner.hpp"
+#include "services/runtime/command_verdict.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
@@ -27,6 +31,14 @@ planner::LocomotionMode toPlannerMode(services::LocomotionMode m) {
     case services::LocomotionMode::Walk: return planner::LocomotionMode::Walk;
   }
   return planner::LocomotionMode::Stand;
+}
+const char* modeName(planner::LocomotionMode m) {
+  switch (m) {
+    case planner::LocomotionMode::Stand: return "stand";
+    case planner::LocomotionMode::StepInPlace: return "step_in_place";
+    case planner::LocomotionMode::Walk: return "walk";
+  }
+  return "?";
 }
 planner::LocomotionMode toPlannerMode(std::uint8_t m) {
   return m == msg::LOCOMOTION_WALK ? planner::LocomotionMode::Walk
@@ -66,6 +78,15 @@ int main(int argc, char** argv) {
   model::RobotStateEstimate state;
   services::LatencyStats update_us;
   const auto& commands = ctx.scenario().commands;
+  // Operator commands judged valid on arrival, applied at the next tick (fixed capacity: no allocation).
+  struct PendingCommand {
+    std::uint64_t seq;
+    planner::OperatorCommand cmd;
+  };
+  std::array<PendingCommand, 32> pending{};
+  std::size_t pending_count = 0;
+  std::uint64_t operator_received = 0, operator_rejected = 0, operator_applied = 0;
+  services::VerdictPublisher verdicts(ctx.participant(), "mft-planner", msg::COMMAND_SOURCE_PLANNER);
 
   auto apply = [&](const planner::OperatorCommand& cmd, const char* origin) {
     const auto result = planner.setCommand(cmd);
@@ -108,6 +129,16 @@ int main(int argc, char** argv) {
           const auto& c = commands[next_command++];
           apply({c.z_cmd_m, c.v_cmd_mps, toPlannerMode(c.mode)}, "scenario");
         }
+        // Operator commands after the scenario's of the same tick: the operator has the last word.
+        for (std::size_t i = 0; i < pending_count; ++i) {
+          const auto& p = pending[i];
+          planner.setCommand(p.cmd);  // judged valid on arrival against the same fixed limits
+          ++operator_applied;
+          verdicts.post(p.seq, msg::VERDICT_APPLIED, m.tick(), m.stamp_ns(),
+                        "mode %s, height %.3f m, speed %.3f m/s in force from tick %llu (t = %.3f s)", modeName(p.cmd.mode),
+                        p.cmd.z_cmd, p.cmd.v_cmd, static_cast<unsigned long long>(m.tick()), state.time_s);
+        }
+        pending_count = 0;
         const auto& plan = planner.update(state_builder.build(state));
         services::toMsg(plan, &out_msg);
         out_msg.tick(m.tick());
@@ -122,26 +153,43 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::OperatorCommand, msg::OperatorCommandPubSubType> command_reader(
       ctx.participant(), "OperatorCommand", "event_reader", [&](const msg::OperatorCommand& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::validInput(m)) {
+        ++operator_received;
+        const planner::OperatorCommand cmd{m.z_cmd(), m.v_cmd(), toPlannerMode(m.mode())};
+        const auto check = planner::checkCommand(cmd, planner.limits());
+        const char* why = !check.accepted                   ? check.reason.c_str()
+                          : m.mode() > msg::LOCOMOTION_WALK ? "unknown locomotion mode (0 stand, 1 step_in_place, 2 walk)"
+                          : !services::validInput(m)        ? "not finite or implausible"
+                          : pending_count == pending.size() ? "too many commands waiting for the next tick"
+                                                            : nullptr;
+        if (why) {
           ++rejected;
-          std::fprintf(stderr, "mft-planner: operator command rejected: not finite or implausible\n");
+          ++operator_rejected;
+          std::fprintf(stderr, "mft-planner: operator command seq %llu rejected: %s\n",
+                       static_cast<unsigned long long>(m.seq()), why);
+          verdicts.post(m.seq(), msg::VERDICT_REJECTED, last_tick, 0, "%s", why);
           return;
         }
-        apply({m.z_cmd(), m.v_cmd(), toPlannerMode(m.mode())}, "operator");
+        pending[pending_count++] = {m.seq(), cmd};
+        verdicts.post(m.seq(), msg::VERDICT_SCHEDULED, last_tick, 0,
+                      "mode %s, height %.3f m, speed %.3f m/s accepted: in force from the next tick", modeName(cmd.mode),
+                      cmd.z_cmd, cmd.v_cmd);
       });
 
   services::announceReady("mft-planner");
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
-  char buf[400];
+  char buf[640];
   std::snprintf(buf, sizeof buf,
                 "{\"service\": \"mft-planner\", \"ticks\": %llu, \"last_tick\": %llu, \"steps\": %llu, "
-                "\"rejected_commands\": %llu, \"refused_inputs\": %llu, \"refused_ticks\": %llu, \"new_clocks\": %llu, "
+                "\"rejected_commands\": %llu, \"operator_commands\": {\"received\": %llu, \"rejected\": %llu, "
+                "\"applied\": %llu, \"waiting\": %zu}, \"refused_inputs\": %llu, \"refused_ticks\": %llu, \"new_clocks\": %llu, "
                 "\"deadline_misses\": %llu, \"update_time_us\": ",
                 static_cast<unsigned long long>(ticks), static_cast<unsigned long long>(last_tick),
                 static_cast<unsigned long long>(planner.output().step_index),
-                static_cast<unsigned long long>(rejected), static_cast<unsigned long long>(refused_inputs),
+                static_cast<unsigned long long>(rejected), static_cast<unsigned long long>(operator_received),
+                static_cast<unsigned long long>(operator_rejected), static_cast<unsigned long long>(operator_applied),
+                pending_count, static_cast<unsigned long long>(refused_inputs),
                 static_cast<unsigned long long>(gate.refused()), static_cast<unsigned long long>(gate.newClocks()),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + update_us.json() + "}");

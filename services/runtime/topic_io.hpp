@@ -33,6 +33,13 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   TopicWriter& operator=(const TopicWriter&) = delete;
 
   bool write(const Msg& msg) { return writer_->write(const_cast<Msg*>(&msg)); }
+  // Reliable writers: waits until every matched reader has acknowledged every sample written so far.
+  bool waitForAcknowledgments(std::chrono::milliseconds timeout) {
+    const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
+    return writer_->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(static_cast<std::int32_t>(ns / 1000000000),
+                                                                            static_cast<std::uint32_t>(ns % 1000000000))) ==
+           eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
+  }
   int matched() const { return matched_.load(); }
   std::uint64_t offeredDeadlineMisses() const { return offered_deadline_misses_.load(); }
 

@@ -3,8 +3,10 @@
 //            as the chain answers; a missing answer is a named timeout error (exit status 3).
 //  realtime: step on the wall clock at 1 kHz (absolute deadlines), apply the latest command (zero-order hold);
 //            the command watchdog puts the actuators into damping when commands stop, and back when they resume.
-// It plays the scenario's pushes (and Disturbance messages from mft-cmd), ends the run at the scenario's
-// duration (or at a fall), and writes the run summary.
+// It plays the scenario's pushes (and Disturbance messages from mft-cmd, each answered on CommandVerdict:
+// rejected with the reason or scheduled on arrival, applied with the time and tick of the physics step that
+// carried it; docs/operator-commands.md), ends the run at the scenario's duration (or at a fall), and writes
+// the run summary.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -16,6 +18,7 @@
 
 #include "MftMsgsPubSubTypes.h"
 #include "model/config/strict_yaml.hpp"
+#include "services/runtime/command_verdict.hpp"
 #include "services/runtime/command_watchdog.hpp"
 #include "services/runtime/stall_probe.hpp"
 #include "services/runtime/convert.hpp"
@@ -153,6 +156,17 @@ int main(int argc, char** argv) {
   model::ActuatorCommand latest;
   bool have_command = false;
   std::vector<sim::ImpulseSpec> pending_pushes;
+  pending_pushes.reserve(64);
+  // Pushes from the Disturbance topic in flight: ImpulseSpec::id (1, 2, ...) -> the request's seq. Fixed
+  // capacity: the loop never allocates; a request beyond it is rejected.
+  struct TopicPush {
+    std::uint64_t id = 0, seq = 0;
+  };
+  std::array<TopicPush, 64> topic_pushes{};
+  std::uint64_t next_push_id = 1, disturbances_received = 0, disturbances_applied = 0;
+  std::vector<std::array<double, 3>> applied_topic_pushes;  // [impulse N s, time s, tick] for the summary
+  applied_topic_pushes.reserve(64);
+  services::VerdictPublisher verdicts(ctx.participant(), "mft-sim", msg::COMMAND_SOURCE_SIMULATOR);
   std::array<std::int64_t, 1024> publish_ns{};  // when SensorData(k) left, by k % 1024 (realtime latency)
   services::LatencyStats latency_us;
   std::uint64_t published_tick = 0;
@@ -198,11 +212,34 @@ int main(int argc, char** argv) {
   services::TopicReader<msg::Disturbance, msg::DisturbancePubSubType> push_reader(
       ctx.participant(), "Disturbance", "event_reader", [&](const msg::Disturbance& m) {
         const auto verdict = services::checkDisturbance(m.impulse_Ns(), m.trigger(), m.time_s(), m.leg(), max_push_Ns);
-        if (verdict != services::InputVerdict::Ok) {
-          std::lock_guard<std::mutex> lock(mutex);
+        std::lock_guard<std::mutex> lock(mutex);
+        ++disturbances_received;
+        const double now_s = static_cast<double>(published_tick) * options.control_period_s;
+        TopicPush* slot = nullptr;
+        for (auto& p : topic_pushes)
+          if (p.id == 0) {
+            slot = &p;
+            break;
+          }
+        if (verdict != services::InputVerdict::Ok || !slot) {
           if (disturbances_rejected++ < 3)
             std::printf("mft-sim: refused a Disturbance (seq %llu): %s\n", static_cast<unsigned long long>(m.seq()),
-                        services::toString(verdict));
+                        slot ? services::toString(verdict) : "too many pushes waiting");
+          const auto seq = m.seq();
+          if (!slot)
+            verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0, "%zu pushes are already waiting to be applied",
+                          topic_pushes.size());
+          else if (verdict == services::InputVerdict::NonFinite)
+            verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0, "impulse or time is not a finite number");
+          else if (verdict == services::InputVerdict::BadEnum)
+            verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0, "unknown trigger %d or leg %d (0 right, 1 left)",
+                          m.trigger(), m.leg());
+          else if (m.time_s() < 0.0)
+            verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0, "negative time %.3f s", m.time_s());
+          else
+            verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0,
+                          "impulse %.3f N s beyond the largest accepted push %.3f N s (mft-sim --max-push)",
+                          m.impulse_Ns(), max_push_Ns);
           return;
         }
         sim::ImpulseSpec spec;
@@ -211,8 +248,16 @@ int main(int argc, char** argv) {
         spec.trigger = m.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF ? sim::ImpulseTrigger::AtLiftOff
                                                                     : sim::ImpulseTrigger::AtTime;
         spec.leg = std::max<int>(0, m.leg());
-        std::lock_guard<std::mutex> lock(mutex);
+        spec.id = next_push_id++;
+        *slot = {spec.id, m.seq()};
         pending_pushes.push_back(spec);
+        if (spec.trigger == sim::ImpulseTrigger::AtLiftOff)
+          verdicts.post(m.seq(), msg::VERDICT_SCHEDULED, published_tick, 0,
+                        "push of %.3f N s will be applied at the next %s-foot lift-off", m.impulse_Ns(),
+                        spec.leg == 0 ? "right" : "left");
+        else
+          verdicts.post(m.seq(), msg::VERDICT_SCHEDULED, published_tick, 0, "push of %.3f N s will be applied at t = %.3f s",
+                        m.impulse_Ns(), std::max(spec.time_s, now_s));
       });
   // Lockstep recording: a starved recorder must slow the simulator down, not lose samples in its socket buffer.
   const auto recorder_window = static_cast<std::uint64_t>(cli.getInt("recorder-window", 0, 1000000));
@@ -417,8 +462,22 @@ int main(int argc, char** argv) {
                                          simulator.stats().body_contact_steps);
     {
       const auto& st = simulator.stats();
-      for (; impulses_seen < st.impulses.size(); ++impulses_seen)
-        recovery.onImpulse(st.impulses[impulses_seen].time_s, st.impulses[impulses_seen].impulse_Ns.x());
+      for (; impulses_seen < st.impulses.size(); ++impulses_seen) {
+        const auto& applied = st.impulses[impulses_seen];
+        recovery.onImpulse(applied.time_s, applied.impulse_Ns.x());
+        if (applied.id == 0) continue;  // a scenario push
+        std::lock_guard<std::mutex> lock(mutex);
+        for (auto& p : topic_pushes)
+          if (p.id == applied.id) {
+            ++disturbances_applied;
+            if (applied_topic_pushes.size() < applied_topic_pushes.capacity())
+              applied_topic_pushes.push_back({applied.impulse_Ns.x(), applied.time_s, static_cast<double>(k)});
+            verdicts.post(p.seq, msg::VERDICT_APPLIED, k, static_cast<std::uint64_t>(std::llround(applied.time_s * 1e9)),
+                          "push of %.3f N s applied at t = %.4f s (tick %llu)", applied.impulse_Ns.x(), applied.time_s,
+                          static_cast<unsigned long long>(k));
+            p = TopicPush{};
+          }
+      }
       recovery.update(simulator.groundTruth(), st.touchdowns[0] + st.touchdowns[1]);
     }
     if (fell_now) {
@@ -461,6 +520,7 @@ int main(int argc, char** argv) {
       "\"average_speed_mps\": %.5f, \"distance_m\": %.5f, \"final_base_height_m\": %.5f, \"impulses_applied\": %zu, "
       "\"max_closure_error_m\": %.3g, \"touchdowns\": [%llu, %llu], \"error\": \"%s\", "
       "\"commands_received\": %llu, \"commands_rejected\": {\"nonfinite\": %llu, \"out_of_range\": %llu, \"bad_mode\": %llu}, "
+      "\"disturbances_received\": %llu, \"disturbances_applied\": %llu, "
       "\"disturbances_rejected\": %llu, \"recorder_window\": %llu, \"recorder_waits\": %llu, \"recorder_wait_s\": %.3f, \"recorder_complete\": %s, ",
       scenario.name.c_str(), ctx.lockstep() ? "lockstep" : "realtime", monitor.fell() ? "true" : "false",
       monitor.fallTime(), monitor.fallReason().c_str(), static_cast<unsigned long long>(simulator.tick()),
@@ -474,7 +534,8 @@ int main(int argc, char** argv) {
       static_cast<unsigned long long>(stats.touchdowns[0]), static_cast<unsigned long long>(stats.touchdowns[1]),
       error.c_str(), static_cast<unsigned long long>(commands_received),
       static_cast<unsigned long long>(commands_rejected[1]), static_cast<unsigned long long>(commands_rejected[2]),
-      static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_rejected),
+      static_cast<unsigned long long>(commands_rejected[3]), static_cast<unsigned long long>(disturbances_received),
+      static_cast<unsigned long long>(disturbances_applied), static_cast<unsigned long long>(disturbances_rejected),
       static_cast<unsigned long long>(progress_reader ? recorder_window : 0), static_cast<unsigned long long>(recorder_waits),
       recorder_wait_s, recorder_complete ? "true" : "false");
   std::string onset_json = "[";
@@ -484,6 +545,14 @@ int main(int argc, char** argv) {
     onset_json += e;
   }
   onset_json += "]";
+  std::string pushes_json = "[";
+  for (std::size_t i = 0; i < applied_topic_pushes.size(); ++i) {
+    char e[96];
+    std::snprintf(e, sizeof e, "%s[%.4f, %.4f, %.0f]", i ? ", " : "", applied_topic_pushes[i][0],
+                  applied_topic_pushes[i][1], applied_topic_pushes[i][2]);
+    pushes_json += e;
+  }
+  pushes_json += "]";
   std::string episode_json = "[";
   for (std::size_t i = 0; i < episodes.size(); ++i) {
     char e[96];
@@ -515,7 +584,7 @@ int main(int argc, char** argv) {
                   static_cast<unsigned long long>(explained), static_cast<unsigned long long>(misses - explained));
     probe_json = std::string(pj) + per_miss;
   }
-  ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
+  ctx.writeSummary(std::string(buf) + "\"topic_pushes_applied\": " + pushes_json + ", \"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
                    ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
                    std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + probe_json + "}");

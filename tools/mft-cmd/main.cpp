@@ -1,103 +1,267 @@
 // mft-cmd: sends an operator command (height, speed, mode) or a disturbance (a sagittal push) to a running
-// stack, and waits until the planner (or the simulator) has matched it, so nothing is sent into the void.
+// stack and reports the stack's verdict (docs/operator-commands.md): it waits until a reader of the stack has
+// matched its writer (reliable, transient local), until the readers have acknowledged the sample, and until
+// the planner (commands) or the simulator (pushes) has answered on CommandVerdict with the command's seq.
+// The exit status says what happened; nothing is reported as done that the stack did not confirm.
+#include <unistd.h>
+
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "MftMsgs.h"
 #include "MftMsgsPubSubTypes.h"
+#include "services/runtime/command_verdict.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
 
 using namespace mft;
-using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Exit statuses (also in --help).
+constexpr int kAccepted = 0, kRejected = 1, kUsage = 2, kNoStack = 3, kNotAcknowledged = 4, kNoVerdict = 5;
+
+std::string jsonString(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// A number with `digits` decimals (fixed) or significant digits (general, digits < 0 means -digits).
+std::string fmt(double a, int digits) {
+  char buf[64];
+  if (digits >= 0) std::snprintf(buf, sizeof buf, "%.*f", digits, a);
+  else std::snprintf(buf, sizeof buf, "%.*g", -digits, a);
+  return buf;
+}
+
+struct Verdict {
+  std::uint8_t verdict = 0;
+  std::uint64_t tick = 0, stamp_ns = 0;
+  std::string reason;
+  double waited_s = 0;  // since the command was written
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
   services::CommandLine cli(
       "mft-cmd",
-      "Send an operator command or a push to a running mft-wbc stack.\n"
+      "Send an operator command or a push to a running mft-wbc stack and wait for its verdict.\n"
       "  mft-cmd --domain 0 --mode step_in_place --height 0.42 --speed 0.0\n"
-      "  mft-cmd --domain 0 --push 3.0 [--at 4.5 | --at-liftoff right]");
+      "  mft-cmd --domain 0 --push 3.0 [--at 4.5 | --at-liftoff right]\n"
+      "The planner answers commands, the simulator pushes: rejected (with the reason), scheduled (a push at a\n"
+      "lift-off or a later time) or applied at a tick. mft-cmd waits for 'applied' (or a rejection) up to\n"
+      "--verdict-timeout; a command still only scheduled then counts as accepted. Protocol:\n"
+      "docs/operator-commands.md.\n"
+      "Exit status: 0 accepted (applied, or scheduled by the stack); 1 rejected by the stack (the reason is\n"
+      "printed); 2 usage, input or DDS set-up error; 3 no stack answered on the domain within --timeout (no\n"
+      "reader matched); 4 the readers did not acknowledge the command within --timeout; 5 no verdict within\n"
+      "--verdict-timeout.");
   cli.option("domain", "DDS domain id of the stack (0..232)", "0");
   cli.option("mode", "stand | step_in_place | walk (an operator command)");
-  cli.option("height", "base height command [m]", "0.42");
+  cli.option("height", "base height command [m] (the planner accepts its reachable range)", "0.42");
   cli.option("speed", "average sagittal speed command [m/s]", "0.0");
   cli.option("push", "sagittal impulse on the torso [N s], + forward (a disturbance)");
-  cli.option("at", "apply the push at this simulated time [s] (default: now)", "0");
+  cli.option("at", "apply the push at this simulated time [s] (0: now)", "0");
   cli.option("at-liftoff", "apply the push at the next lift-off of this leg: right | left");
-  cli.option("seq", "sequence number of the message (default: wall-clock based)");
-  cli.option("timeout", "seconds to wait for the stack to match", "5");
+  cli.option("seq", "sequence number of the command, echoed by its verdict (default: from the clock and pid)");
+  cli.option("timeout", "seconds to wait for a reader of the stack to match, and again for the acknowledgement", "5");
+  cli.option("verdict-timeout", "seconds to wait for the stack's verdict once the command is written", "10");
+  cli.flag("accepted-only", "return at the first acceptance (scheduled) instead of waiting until it is applied");
   cli.option("profiles", "DDS QoS profile file", MFT_DDS_PROFILES);
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (secured stacks)");
   cli.option("identity", "with --secure: the identity to use", "cmd");
-  cli.flag("json", "print what was sent as JSON");
+  cli.flag("json", "print one JSON object with the command, the verdicts and the result (also on failure)");
   cli.parse(argc, argv);
 
   const bool has_cmd = cli.isSet("mode"), has_push = cli.isSet("push");
   if (has_cmd == has_push) cli.fail("give either --mode (an operator command) or --push (a disturbance)");
+  if (has_cmd && (cli.isSet("at") || cli.isSet("at-liftoff"))) cli.fail("--at and --at-liftoff go with --push");
+  if (has_push && (cli.isSet("height") || cli.isSet("speed"))) cli.fail("--height and --speed go with --mode");
+  if (cli.isSet("at") && cli.isSet("at-liftoff")) cli.fail("give --at or --at-liftoff, not both");
+  const int domain = static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId));
+  // Unique across processes started in the same millisecond: the pid in the low 16 bits.
   const auto seq = cli.isSet("seq")
-                       ? static_cast<unsigned long long>(cli.getInt("seq", 0, 1L << 62))
-                       : static_cast<unsigned long long>(
-                             std::chrono::system_clock::now().time_since_epoch() / std::chrono::milliseconds(1));
-  const auto timeout = std::chrono::milliseconds(static_cast<long>(cli.getDouble("timeout", 0.1, 600) * 1000));
-  try {
-    services::DdsParticipant participant(static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId)),
-                                         cli.get("profiles"), "mft-cmd",
-                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")});
-    if (has_cmd) {
-      msg::OperatorCommand m;
-      const std::string mode = cli.get("mode");
-      if (mode == "stand") m.mode(msg::LOCOMOTION_STAND);
-      else if (mode == "step_in_place") m.mode(msg::LOCOMOTION_STEP_IN_PLACE);
-      else if (mode == "walk") m.mode(msg::LOCOMOTION_WALK);
-      else cli.fail("--mode: unknown mode '" + mode + "' (stand, step_in_place or walk)");
-      m.seq(seq);
-      m.z_cmd(cli.getDouble("height", 0.0, 2.0));
-      m.v_cmd(cli.getDouble("speed", -5.0, 5.0));
-      services::TopicWriter<msg::OperatorCommand, msg::OperatorCommandPubSubType> w(participant, "OperatorCommand",
-                                                                                      "event_writer");
-      if (!services::waitUntil([&] { return w.matched() > 0; }, timeout)) {
-        std::fprintf(stderr, "mft-cmd: no planner on domain %ld answered within the timeout\n", cli.getInt("domain", 0, 232));
-        return 1;
-      }
-      w.write(m);
-      if (cli.isSet("json"))
-        std::printf("{\"sent\": \"OperatorCommand\", \"seq\": %llu, \"mode\": \"%s\", \"z_cmd\": %.6g, \"v_cmd\": %.6g}\n",
-                    seq, mode.c_str(), m.z_cmd(), m.v_cmd());
-      else
-        std::printf("sent OperatorCommand seq %llu: %s, height %.3f m, speed %.3f m/s\n", seq, mode.c_str(), m.z_cmd(), m.v_cmd());
-    } else {
-      msg::Disturbance d;
-      d.seq(seq);
-      d.impulse_Ns(cli.getDouble("push", -200.0, 200.0));
-      d.time_s(cli.getDouble("at", 0.0, 1e6));
-      d.trigger(msg::TRIGGER_AT_TIME);
-      d.leg(-1);
-      if (cli.isSet("at-liftoff")) {
-        const std::string leg = cli.get("at-liftoff");
-        if (leg != "right" && leg != "left") cli.fail("--at-liftoff: expected right or left");
-        d.trigger(msg::TRIGGER_AT_NEXT_LIFTOFF);
-        d.leg(static_cast<std::int16_t>(leg == "right" ? 0 : 1));
-      }
-      services::TopicWriter<msg::Disturbance, msg::DisturbancePubSubType> w(participant, "Disturbance", "event_writer");
-      if (!services::waitUntil([&] { return w.matched() > 0; }, timeout)) {
-        std::fprintf(stderr, "mft-cmd: no simulator on domain %ld answered within the timeout\n", cli.getInt("domain", 0, 232));
-        return 1;
-      }
-      w.write(d);
-      if (cli.isSet("json"))
-        std::printf("{\"sent\": \"Disturbance\", \"seq\": %llu, \"impulse_Ns\": %.6g, \"trigger\": \"%s\", \"time_s\": %.6g, \"leg\": %d}\n",
-                    seq, d.impulse_Ns(), d.trigger() == msg::TRIGGER_AT_TIME ? "at_time" : "at_next_liftoff", d.time_s(), d.leg());
-      else
-        std::printf("sent Disturbance seq %llu: %.3f N s %s\n", seq, d.impulse_Ns(),
-                    d.trigger() == msg::TRIGGER_AT_TIME ? "at time" : "at next lift-off");
+                       ? static_cast<std::uint64_t>(cli.getInt("seq", 0, 1L << 62))
+                       : (static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                                     std::chrono::milliseconds(1))
+                          << 16) | (static_cast<std::uint64_t>(getpid()) & 0xffffu);
+  const double timeout_s = cli.getDouble("timeout", 0.1, 600);
+  const double verdict_timeout_s = cli.getDouble("verdict-timeout", 0.1, 3600);
+  const auto timeout = std::chrono::milliseconds(static_cast<long>(timeout_s * 1000));
+  const bool json = cli.isSet("json");
+  const bool accepted_only = cli.isSet("accepted-only");
+
+  // The command, and how it is described in the output.
+  msg::OperatorCommand command;
+  msg::Disturbance push;
+  std::string topic, answerer, what_json, what_text;
+  if (has_cmd) {
+    const std::string mode = cli.get("mode");
+    if (mode == "stand") command.mode(msg::LOCOMOTION_STAND);
+    else if (mode == "step_in_place") command.mode(msg::LOCOMOTION_STEP_IN_PLACE);
+    else if (mode == "walk") command.mode(msg::LOCOMOTION_WALK);
+    else cli.fail("--mode: unknown mode '" + mode + "' (stand, step_in_place or walk)");
+    command.seq(seq);
+    command.z_cmd(cli.getDouble("height", -100.0, 100.0));
+    command.v_cmd(cli.getDouble("speed", -100.0, 100.0));
+    topic = "OperatorCommand";
+    answerer = "mft-planner";
+    what_json = "\"mode\": \"" + mode + "\", \"z_cmd\": " + fmt(command.z_cmd(), -6) +
+                ", \"v_cmd\": " + fmt(command.v_cmd(), -6);
+    what_text = mode + ", height " + fmt(command.z_cmd(), 3) + " m, speed " + fmt(command.v_cmd(), 3) + " m/s";
+  } else {
+    push.seq(seq);
+    push.impulse_Ns(cli.getDouble("push", -1e4, 1e4));
+    push.time_s(cli.getDouble("at", 0.0, 1e6));
+    push.trigger(msg::TRIGGER_AT_TIME);
+    push.leg(-1);
+    if (cli.isSet("at-liftoff")) {
+      const std::string leg = cli.get("at-liftoff");
+      if (leg != "right" && leg != "left") cli.fail("--at-liftoff: expected right or left");
+      push.trigger(msg::TRIGGER_AT_NEXT_LIFTOFF);
+      push.leg(static_cast<std::int16_t>(leg == "right" ? 0 : 1));
     }
-    // Reliable transient-local writers: give the reader a moment to acknowledge before the process ends.
-    std::this_thread::sleep_for(200ms);
-  } catch (const services::DdsError& e) {
-    std::fprintf(stderr, "mft-cmd: %s\n", e.what());
-    return 2;
+    topic = "Disturbance";
+    answerer = "mft-sim";
+    const bool liftoff = push.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF;
+    what_json = "\"impulse_Ns\": " + fmt(push.impulse_Ns(), -6) + ", \"trigger\": \"" +
+                (liftoff ? "at_next_liftoff" : "at_time") + "\", \"time_s\": " + fmt(push.time_s(), -6) +
+                ", \"leg\": " + std::to_string(push.leg());
+    what_text = fmt(push.impulse_Ns(), 3) + " N s " +
+                (liftoff ? std::string("at the next ") + (push.leg() == 0 ? "right" : "left") + "-foot lift-off"
+                         : cli.isSet("at") ? "at t = " + fmt(push.time_s(), 3) + " s" : std::string("now"));
   }
-  return 0;
+  const std::uint8_t source = has_cmd ? msg::COMMAND_SOURCE_PLANNER : msg::COMMAND_SOURCE_SIMULATOR;
+
+  int matched = 0;
+  bool acknowledged = false;
+  std::vector<Verdict> verdicts;
+  // One line on stderr (and the JSON object on stdout with --json) for every outcome.
+  auto finish = [&](int code, const std::string& result, const std::string& error) {
+    if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
+    if (json) {
+      std::string v = "[";
+      for (const auto& x : verdicts)
+        v += std::string(v.size() > 1 ? ", " : "") + "{\"verdict\": \"" + services::verdictName(x.verdict) +
+             "\", \"tick\": " + std::to_string(x.tick) + ", \"time_s\": " + fmt(static_cast<double>(x.stamp_ns) * 1e-9, 4) +
+             ", \"reason\": " + jsonString(x.reason) + ", \"after_s\": " + fmt(x.waited_s, 3) + "}";
+      v += "]";
+      std::printf("{\"command\": \"%s\", \"seq\": %llu, \"domain\": %d, %s, \"readers_matched\": %d, "
+                  "\"acknowledged\": %s, \"answered_by\": \"%s\", \"verdicts\": %s, \"result\": \"%s\", \"exit_code\": %d, "
+                  "\"error\": %s}\n",
+                  topic.c_str(), static_cast<unsigned long long>(seq), domain, what_json.c_str(), matched,
+                  acknowledged ? "true" : "false", answerer.c_str(), v.c_str(), result.c_str(), code, jsonString(error).c_str());
+    }
+    std::fflush(stdout);
+    return code;
+  };
+
+  try {
+    services::DdsParticipant participant(domain, cli.get("profiles"), "mft-cmd",
+                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")});
+    std::mutex mutex;
+    std::vector<Verdict> received;
+    Clock::time_point written_at = Clock::now();
+    // The verdict reader exists before the command is written; the stack's verdict writers are transient
+    // local, so a verdict written before this reader matched them still arrives.
+    services::TopicReader<msg::CommandVerdict, msg::CommandVerdictPubSubType> verdict_reader(
+        participant, "CommandVerdict", "event_reader", [&](const msg::CommandVerdict& m) {
+          if (m.seq() != seq || m.source() != source) return;  // another command's, or the other service's
+          std::lock_guard<std::mutex> lock(mutex);
+          Verdict v;
+          v.verdict = m.verdict();
+          v.tick = m.tick();
+          v.stamp_ns = m.stamp_ns();
+          v.reason.assign(m.reason().data(), strnlen(m.reason().data(), m.reason().size()));
+          v.waited_s = std::chrono::duration<double>(Clock::now() - written_at).count();
+          received.push_back(v);
+        });
+    std::unique_ptr<services::TopicWriter<msg::OperatorCommand, msg::OperatorCommandPubSubType>> command_writer;
+    std::unique_ptr<services::TopicWriter<msg::Disturbance, msg::DisturbancePubSubType>> push_writer;
+    if (has_cmd)
+      command_writer = std::make_unique<services::TopicWriter<msg::OperatorCommand, msg::OperatorCommandPubSubType>>(
+          participant, topic, "command_writer");
+    else
+      push_writer = std::make_unique<services::TopicWriter<msg::Disturbance, msg::DisturbancePubSubType>>(
+          participant, topic, "command_writer");
+    const auto readers = [&] { return has_cmd ? command_writer->matched() : push_writer->matched(); };
+
+    if (!services::waitUntil([&] { return readers() > 0; }, timeout))
+      return finish(kNoStack, "no_stack",
+                    "no stack answered on domain " + std::to_string(domain) + " within " + fmt(timeout_s, -6) +
+                        " s (no reader of " + topic + "; is the stack up on this domain?)");
+    written_at = Clock::now();
+    const bool written = has_cmd ? command_writer->write(command) : push_writer->write(push);
+    if (!written) return finish(kUsage, "error", "the DDS writer refused the " + topic);
+    acknowledged = has_cmd ? command_writer->waitForAcknowledgments(timeout) : push_writer->waitForAcknowledgments(timeout);
+    matched = readers();
+    if (!json) {
+      std::printf("mft-cmd: %s seq %llu (%s) written to %d reader(s) on domain %d, %s\n", topic.c_str(),
+                  static_cast<unsigned long long>(seq), what_text.c_str(), matched, domain,
+                  acknowledged ? "acknowledged" : "NOT acknowledged yet");
+      std::fflush(stdout);
+    }
+
+    // The verdicts: rejected, or scheduled then applied.
+    const auto verdict_deadline = written_at + std::chrono::duration<double>(verdict_timeout_s);
+    std::size_t shown = 0;
+    bool scheduled = false;
+    for (;;) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        verdicts = received;
+      }
+      for (; shown < verdicts.size(); ++shown) {
+        const auto& v = verdicts[shown];
+        if (v.verdict == msg::VERDICT_REJECTED)
+          return finish(kRejected, "rejected", answerer + " rejected " + topic + " seq " + std::to_string(seq) + ": " + v.reason);
+        if (!json)
+          std::printf("%s: %s at tick %llu: %s\n", answerer.c_str(), services::verdictName(v.verdict),
+                      static_cast<unsigned long long>(v.tick), v.reason.c_str());
+        std::fflush(stdout);
+        if (v.verdict == msg::VERDICT_APPLIED) return finish(kAccepted, "applied", "");
+        if (v.verdict == msg::VERDICT_SCHEDULED) scheduled = true;
+      }
+      if (scheduled && accepted_only) return finish(kAccepted, "scheduled", "");
+      if (Clock::now() > verdict_deadline) break;
+      if (!acknowledged && !scheduled && Clock::now() > written_at + timeout)
+        return finish(kNotAcknowledged, "not_acknowledged",
+                      "the " + std::to_string(matched) + " reader(s) of " + topic + " on domain " + std::to_string(domain) +
+                          " did not acknowledge seq " + std::to_string(seq) + " within " + fmt(timeout_s, -6) + " s");
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (scheduled) {
+      if (!json)
+        std::printf("mft-cmd: accepted by %s, not applied within %g s (it stays scheduled)\n", answerer.c_str(),
+                    verdict_timeout_s);
+      return finish(kAccepted, "scheduled", "");
+    }
+    return finish(kNoVerdict, "no_verdict",
+                  "no verdict from " + answerer + " on " + topic + " seq " + std::to_string(seq) + " within " +
+                      fmt(verdict_timeout_s, -6) + " s (" + (acknowledged ? "acknowledged" : "not acknowledged") + " by " +
+                      std::to_string(matched) + " reader(s); is " + answerer + " running?)");
+  } catch (const services::DdsError& e) {
+    return finish(kUsage, "error", e.what());
+  }
 }

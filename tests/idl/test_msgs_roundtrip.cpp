@@ -1,6 +1,9 @@
 // The generated topic types: bounded (fixed size, no type objects), and every field survives a CDR round trip.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iterator>
+
 #include "MftMsgs.h"
 #include "MftMsgsPubSubTypes.h"
 
@@ -76,4 +79,15 @@ TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
   dist.impulse_Ns(7.1);
   dist.trigger(mft::msg::TRIGGER_AT_NEXT_LIFTOFF);
   EXPECT_TRUE((roundTrip<mft::msg::Disturbance, mft::msg::DisturbancePubSubType>(dist) == dist));
+  mft::msg::CommandVerdict verdict;
+  verdict.seq(0x1234567890abcdefULL);
+  verdict.source(mft::msg::COMMAND_SOURCE_SIMULATOR);
+  verdict.verdict(mft::msg::VERDICT_APPLIED);
+  verdict.accepted(true);
+  verdict.tick(3085);
+  const char reason[] = "push of 3.000 N s applied at t = 3.0850 s (tick 3085)";
+  std::copy(std::begin(reason), std::end(reason), verdict.reason().begin());
+  const auto back = roundTrip<mft::msg::CommandVerdict, mft::msg::CommandVerdictPubSubType>(verdict);
+  EXPECT_TRUE(back == verdict);
+  EXPECT_STREQ(back.reason().data(), reason);
 }

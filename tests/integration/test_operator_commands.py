@@ -74,9 +74,11 @@ class OperatorCommandsOnARunningStack(unittest.TestCase):
                     ("step_in_place", 0.41), ("step_in_place", 0.42)]
         last_tick = 0
         for i, (mode, height) in enumerate(commands):
-            code, result, err, _ = mft_cmd(DOMAIN_STACK, "--mode", mode, "--height", height, "--speed", 0.0)
+            code, result, err, wall = mft_cmd(DOMAIN_STACK, "--mode", mode, "--height", height, "--speed", 0.0)
             applied = self.assert_applied(code, result, err, f"command {i + 1}")
             self.sent["applied_commands"] += 1
+            self.sent.setdefault("after_s", []).append(applied["after_s"])
+            self.sent.setdefault("wall_s", []).append(wall)
             self.assertIn(f"height {height:.3f} m", applied["reason"])
             self.assertGreater(applied["tick"], last_tick)  # each in force from a later tick of the one clock
             last_tick = applied["tick"]
@@ -85,8 +87,10 @@ class OperatorCommandsOnARunningStack(unittest.TestCase):
         pushes = [("now", 2.0), ("right", 2.0), ("now", -2.0), ("left", 2.0), ("now", 1.5), ("right", -1.5)]
         for i, (when, impulse) in enumerate(pushes):
             extra = [] if when == "now" else ["--at-liftoff", when]
-            code, result, err, _ = mft_cmd(DOMAIN_STACK, "--push", impulse, *extra)
+            code, result, err, wall = mft_cmd(DOMAIN_STACK, "--push", impulse, *extra)
             applied = self.assert_applied(code, result, err, f"push {i + 1}")
+            self.sent.setdefault("after_s", []).append(applied["after_s"])
+            self.sent.setdefault("wall_s", []).append(wall)
             self.sent["pushes"].append(impulse)
             self.assertEqual(result["verdicts"][0]["verdict"], "scheduled", result)
             if when != "now":
@@ -131,6 +135,9 @@ class OperatorCommandsOnARunningStack(unittest.TestCase):
         self.assertEqual([p[0] for p in sim["topic_pushes_applied"]], self.sent["pushes"], sim)
         # The impulse the simulator applied is the one asked for (one physics step of J/h).
         self.assertEqual(sim["impulses_applied"], len(self.sent["pushes"]), sim)
+        print(f"\n{len(self.sent['wall_s'])} applied commands and pushes: mft-cmd took "
+              f"{min(self.sent['wall_s']):.2f}-{max(self.sent['wall_s']):.2f} s, the 'applied' verdict came "
+              f"{min(self.sent['after_s']):.3f}-{max(self.sent['after_s']):.3f} s after the write", file=sys.stderr)
         # The logs agree: one 'applied' line per command.
         log = (self.run_dir / "mft-planner.log").read_text(errors="replace")
         self.assertEqual(len(re.findall(r"mft-planner: command seq \d+: applied at tick \d+", log)),
@@ -164,6 +171,7 @@ class OperatorCommandsWithoutAStack(unittest.TestCase):
         self.assertEqual(result["result"], "no_stack")
         self.assertGreaterEqual(wall, 2.0)
         self.assertLess(wall, 8.0, "mft-cmd did not keep its bound")
+        print(f"\nmft-cmd on an empty domain with --timeout 2: exit 3 after {wall:.2f} s", file=sys.stderr)
         code, result, err, wall = mft_cmd(DOMAIN_EMPTY, "--push", 3, "--timeout", 1)
         self.assertEqual(code, 3, err)
         self.assertIn(f"no stack answered on domain {DOMAIN_EMPTY} within 1 s", err)
@@ -193,6 +201,11 @@ class OperatorCommandsWithoutAStack(unittest.TestCase):
         recorder = self.start(BIN / "mft-record", "--domain", DOMAIN_LATE, "--scenario", SCENARIOS / "stand.yaml",
                               "--output", self.tmp / "late.rawlog")
         self.read_line_matching(recorder, r"^READY mft-record", 30)
+        # A reader that acknowledges but never answers: no verdict within the bound is a failure, not "sent".
+        code, result, err, wall = mft_cmd(DOMAIN_LATE, "--mode", "stand", "--height", 0.4, "--verdict-timeout", 1.5)
+        self.assertEqual(code, 5, (result, err))
+        self.assertEqual((result["result"], result["acknowledged"], result["readers_matched"]), ("no_verdict", True, 1))
+        self.assertIn("no verdict from mft-planner on OperatorCommand seq", err)
         cmd = self.start(BIN / "mft-cmd", "--domain", DOMAIN_LATE, "--mode", "stand", "--height", 0.9,
                          "--verdict-timeout", 60)
         self.read_line_matching(cmd, r"OperatorCommand seq \d+ .* written to 1 reader\(s\) on domain \d+, acknowledged", 30)

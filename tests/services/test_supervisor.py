@@ -88,7 +88,10 @@ class SupervisorTest(unittest.TestCase):
 
     def test_realtime_restarts_a_crashed_service_with_backoff(self):
         code, out, err = self.supervisor("run", str(self.scenario), "--domain", "8", "--mode", "realtime", "--json",
-                                         fake="mft-sim:run_for=6,mft-wbc:crash_after=0.2:crash_times=2")  # room for slow starts under load
+                                         fake="mft-sim:run_for=40:until_started=mft-wbc/3,mft-wbc:crash_after=0.2:crash_times=2")
+        # The run lasts until the WBC's third start (40 s, within the 60 s the test waits, only guards a hang).
+        # It used to last a fixed 6 s, which the two crash-restart cycles (a Python start each) overran at load
+        # average 19 with the other core busy: 1 restart instead of 2.
         self.assertEqual(code, 0, err)
         s = json.loads(out)
         self.assertEqual(s["restarts"], 2)
@@ -116,7 +119,7 @@ class SupervisorTest(unittest.TestCase):
         deadline = time.time() + 20
         while len(self.started_pids()) < 4 and time.time() < deadline:
             time.sleep(0.05)
-        self.assertEqual(len(self.started_pids()), 4)
+        self.assertEqual(len(self.started_pids()), 4, "the supervisor did not start the 4 fake services within 20 s")
         self.assertTrue(all(pid_alive(pid) for pid in self.started_pids()))
         p.kill()
         p.wait()

@@ -16,6 +16,9 @@ import time
 import unittest
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import reserve_cpu_share  # noqa: E402
+
 REPO = Path(__file__).resolve().parent.parent.parent
 TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
@@ -164,4 +167,5 @@ class ExperimentTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main(verbosity=2)

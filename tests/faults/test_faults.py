@@ -20,7 +20,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, fifo_priority  # noqa: E402
+from simlog import SimLog, fifo_priority, reserve_cpu_share  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
@@ -204,4 +204,5 @@ class FaultTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main(verbosity=2)

@@ -25,6 +25,11 @@ DOMAIN = 220
 # secured chain to connect (SECURE_START_TIMEOUT_S in services/mft-supervisor), past which Fast DDS's handshake
 # is taken as stuck. On an idle machine it takes 0.3-1.2 s.
 SECURE_MATCH_TIMEOUT_S = 10
+# Fast DDS 2.9.1's handshake between two participants sometimes never completes (docs/security.md; seen here
+# with the other core busy: a new participant of the recorder's identity matched neither the simulator's nor
+# the WBC's writer within 10 s). The supervisor then starts a new participant (SECURE_RUN_ATTEMPTS = 2), which
+# authenticates afresh; the test does the same with its listener, at most this many times, and says so.
+SECURE_MATCH_ATTEMPTS = 3
 
 
 class SecurityTest(unittest.TestCase):
@@ -112,12 +117,18 @@ class SecurityTest(unittest.TestCase):
         # SCHED_FIFO stack). A fixed 3 s window that included it failed once under load with the JointCommand
         # reader never matched; the window now starts once both readers have a writer (bounded), and from then
         # on every tick arrives.
-        code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "record",
-                              "--listen", "SensorData,JointCommand", "--wait-writers", SECURE_MATCH_TIMEOUT_S,
-                              "--seconds", 3)
+        for attempt in range(1, SECURE_MATCH_ATTEMPTS + 1):
+            code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "record",
+                                  "--listen", "SensorData,JointCommand", "--wait-writers", SECURE_MATCH_TIMEOUT_S,
+                                  "--seconds", 3)
+            if r["writers_matched_after_s"] >= 0.0:
+                break
+            print(f"\nrecorder identity, participant {attempt}: no writer matched on every topic within "
+                  f"{SECURE_MATCH_TIMEOUT_S} s (stuck secure handshake): {r['listen']}", file=sys.stderr)
         self.assertGreaterEqual(r["writers_matched_after_s"], 0.0,
                                 f"the recorder identity's readers had no matched writer on every topic within "
-                                f"{SECURE_MATCH_TIMEOUT_S} s (secure handshake not finished): {r}")
+                                f"{SECURE_MATCH_TIMEOUT_S} s, with {SECURE_MATCH_ATTEMPTS} new participants "
+                                f"(secure handshake not finished): {r}")
         handshake_s = r["writers_matched_after_s"]
         for topic in ("SensorData", "JointCommand"):
             t = r["listen"][topic]
@@ -152,7 +163,8 @@ class SecurityTest(unittest.TestCase):
         self.assertLess(abs(sim["final_base_height_m"] - 0.40), 0.01)
         print(f"\nsecured stack: stranger listened 0 samples, stranger wrote {r['written']} JointCommands, sim received "
               f"{sim['commands_received']} commands for {wbc['ticks']} WBC ticks, final base height "
-              f"{sim['final_base_height_m']:.4f} m; the recorder identity matched after {handshake_s:.2f} s", file=sys.stderr)
+              f"{sim['final_base_height_m']:.4f} m; the recorder identity matched after {handshake_s:.2f} s "
+              f"(participant {attempt})", file=sys.stderr)
 
     def test_plain_stack_would_take_the_strangers_commands(self):
         # The same stranger on a stack without --secure: its commands do reach the simulator. This is what

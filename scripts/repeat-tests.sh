@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one CTest test again and again, each run in a private network namespace, until it fails or COUNT runs
 # passed; optionally with one CPU kept busy by a busy loop this script starts (and stops, by pid). Prints a
-# line per run (duration, load average) and a summary; the output of a failing run is kept in a file.
+# line per run (duration, load average) and a summary; the output of every run is kept in a file.
 # Test reliability figures in docs/testing.md come from this script.
 set -u
 
@@ -16,7 +16,7 @@ Each run: unshare -n sh -c 'ip link set lo up; ctest --test-dir DIR -R "^NAME$" 
   --busy-core      keep one CPU busy with a shell busy loop pinned to it (taskset) for the whole series
   --cpu N          the CPU to keep busy (default: the last one)
   --build-dir DIR  the CTest build folder (default: build/release)
-  --log-dir DIR    where the output of a failing run is kept (default: a new folder under /tmp)
+  --log-dir DIR    where the output of every run is kept, run-N.log (default: a new folder under /tmp)
   --results FILE   append one tab-separated line: date, name, busy, runs, passes, first failure,
                    min/median/max duration s, load average (1 min) at start and end
 Exit status: 0 when all COUNT runs passed, 1 at a failure, 2 on bad usage.
@@ -91,7 +91,6 @@ for i in $(seq 1 "$count"); do
   if [ "$code" = 0 ] && grep -q "100% tests passed, 0 tests failed out of 1" "$out"; then
     passes=$((passes + 1))
     echo "$name run $i: passed in $d s (load $(load1))"
-    rm -f "$out"
   else
     first_failure=$i
     echo "$name run $i: FAILED (exit $code) after $d s (load $(load1)); output kept in $out"

@@ -20,7 +20,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, fifo_priority, reserve_cpu_share  # noqa: E402
+from simlog import SimLog, fifo_priority, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
@@ -37,7 +37,9 @@ class Injector:
     "counting from now" line (--wait-writers) before acting, and read its JSON report at the end."""
 
     def __init__(self, args):
-        self.proc = subprocess.Popen([str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"],
+        # At SCHED_FIFO just below the stack (tests/simlog.py): the watch and the attack keep up with 1 kHz.
+        cmd = helper_realtime_prefix() + [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
+        self.proc = subprocess.Popen(cmd,
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.lines, self.counting = [], threading.Event()
         self.reader = threading.Thread(target=self._read, daemon=True)

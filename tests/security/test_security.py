@@ -13,7 +13,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, reserve_cpu_share  # noqa: E402
+from simlog import SimLog, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
@@ -87,7 +87,8 @@ class SecurityTest(unittest.TestCase):
                 for n in ("mft-sim", "mft-wbc", "mft-estimator", "mft-planner")}
 
     def inject(self, *args, timeout=60):
-        cmd = [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
+        # At SCHED_FIFO just below the stack (tests/simlog.py): a listener's counts do not depend on the load.
+        cmd = helper_realtime_prefix() + [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.procs.append(p)
         out, err = p.communicate(timeout=timeout)

@@ -181,9 +181,10 @@ class SecurityTest(unittest.TestCase):
         self.assertGreater(sim["commands_received"] - wbc["ticks"], 500, (sim["commands_received"], wbc["ticks"]))
 
     def test_secured_stack_steps_in_place_in_lockstep(self):
+        run_dir = self.tmp / "run-lockstep"
         code, out, err = self.sup("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
-                                  "--json", "--run-dir", self.tmp / "run-lockstep")
-        self.assertEqual(code, 0, err[-3000:])
+                                  "--json", "--run-dir", run_dir)
+        self.assertEqual(code, 0, err[-3000:] + "\nmft-sim.log:\n" + SimLog(run_dir / "mft-sim.log").text()[-3000:])
         s = json.loads(out)
         self.assertTrue(s["secure"])
         self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))

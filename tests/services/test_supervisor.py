@@ -159,7 +159,10 @@ class SupervisorTest(unittest.TestCase):
         opts = ["--bin-dir", str(self.bin), "--config-dir", str(self.cfg)]
         r = subprocess.run(base + ["up", str(self.scenario), "--domain", "13", "--chain-cpu", str(chain_cpu),
                                    "--record", str(self.tmp / "x.rawlog")] + opts,
-                           env=env, capture_output=True, text=True, timeout=60)
+                           env=env, capture_output=True, text=True, timeout=90)
+        # 90 s: longer than `up`'s own bound for the stack to come up (2 x READY_TIMEOUT_S = 60 s), so that a
+        # slow start fails with the supervisor's message, not the test's timeout (the chain is pinned to the
+        # last CPU, the one scripts/repeat-tests.sh --busy-core keeps busy).
         try:
             self.assertEqual(r.returncode, 0, r.stderr)
             started = {l.split()[0]: int(l.split()[1]) for l in self.pid_log.read_text().splitlines()}

@@ -227,8 +227,8 @@ class DistributedTest(unittest.TestCase):
         sim_log.wait_for_sim_time(3.0)  # standing, settled
         cut_lo, cut_hi = net.cut("ctrl", 0.2)
         # Until the robot stands again with commands on every tick for a whole second (the progress lines come
-        # every second of sim time, so one second after the newest line the link is certainly back). Bound:
-        # the stand-up took under 2 s when measured; 30 s only guards against a hang.
+        # every second of sim time, so one second after the newest line the link is certainly back). The test
+        # used to sleep 2.5 s and then assert the height; 30 s only guards against a hang.
         sim_log.wait_for_commands_flowing(sim_log.sim_time() + 1.0, timeout=30, base_z=STAND_HEIGHT_M, z_tol=0.01)
         s = self.down(domain, st)
         sim, rec = s["mft-sim"], s["mft-record"]
@@ -350,8 +350,8 @@ class DistributedTest(unittest.TestCase):
         # stopped. With the other core busy that failed (last episode ended at 6.777 s, asserted 6.666 s): under
         # the limit the robot falls (reported, docs/distributed.md), the WBC then stands it back up, and on a
         # loaded machine a single late command in those last 0.5 s is a damping episode of its own. What
-        # holds under load is that the chain answers every tick again for a sustained stretch, with a bound:
-        # 30 s only guards against a hang (it took 0.5-3 s when measured, docs/distributed.md).
+        # holds under load is that the chain answers every tick again for a sustained stretch; 30 s only guards
+        # against a hang (the test prints when the stretch ended; docs/testing.md).
         cleared_after_s = sim_log.sim_time() + 1.0
         flowing_s = sim_log.wait_for_commands_flowing(cleared_after_s, timeout=30)
         s = self.down(domain, st)

@@ -156,3 +156,23 @@ def helper_realtime_prefix():
             ok = False
         _helper_prefix = cmd if ok else []
     return list(_helper_prefix)
+
+
+def run_tests():
+    """unittest.main for a multi-process test: reserves its CPU share, and prints each failure's traceback as
+    it happens (CTest kills a test past its TIMEOUT before unittest prints them at the end)."""
+    import unittest
+
+    class ImmediateResult(unittest.TextTestResult):
+        def addFailure(self, test, err):
+            super().addFailure(test, err)
+            self.stream.writeln(f"\nFAIL {test.id()}:\n{self.failures[-1][1]}")
+            self.stream.flush()
+
+        def addError(self, test, err):
+            super().addError(test, err)
+            self.stream.writeln(f"\nERROR {test.id()}:\n{self.errors[-1][1]}")
+            self.stream.flush()
+
+    reserve_cpu_share()
+    unittest.main(verbosity=2, testRunner=unittest.TextTestRunner(resultclass=ImmediateResult, verbosity=2))

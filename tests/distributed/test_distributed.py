@@ -32,7 +32,7 @@ from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
 
 from stack_layout import BIN, HOSTS, PLACEMENT, REPO, SCENARIOS, SUPERVISOR  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, reserve_cpu_share  # noqa: E402
+from simlog import SimLog, run_tests  # noqa: E402
 CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
 PERMITTED, WHY_NOT = netns_permitted()
 # Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/distributed.md):
@@ -369,5 +369,4 @@ class DistributedTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
-    unittest.main(verbosity=2)
+    run_tests()  # nice -10, failures printed as they happen (tests/simlog.py)

@@ -132,6 +132,7 @@ int main(int argc, char** argv) {
   services::CommandWatchdog watchdog(watchdog_timeout_ns);
   services::LatencyStats detection_ms(10000);
   bool damping_now = false;
+  double damping_onset_s = 0.0;  // sim time of the current damping episode's onset
   std::vector<std::array<double, 3>> episodes;  // damping episodes: [onset sim time s, ms after deadline, duration ms]
   std::vector<double> onset_sim_late_ms;         // per miss: the simulator's own worst lateness in the 8 periods before
   episodes.reserve(64);                          // both capped at 64: nothing allocates in the loop
@@ -433,8 +434,14 @@ int main(int argc, char** argv) {
                     static_cast<double>(watchdog_timeout_ns) * 1e-6 + late_ms, simulator.time());
         std::fflush(stdout);
       }
-      if (was_damping && !damping_now && !episodes.empty() && episodes.back()[2] < 0)
-        episodes.back()[2] = (simulator.time() - episodes.back()[0]) * 1e3;
+      if (damping_now && !was_damping) damping_onset_s = simulator.time();
+      if (was_damping && !damping_now) {
+        if (!episodes.empty() && episodes.back()[2] < 0) episodes.back()[2] = (simulator.time() - episodes.back()[0]) * 1e3;
+        // The counterpart of the onset line: tests wait for it instead of sleeping until commands flow again.
+        std::printf("mft-sim: commands resumed after %.1f ms of damping (t = %.3f s)\n",
+                    (simulator.time() - damping_onset_s) * 1e3, simulator.time());
+        std::fflush(stdout);
+      }
       if (!have_command) {
         command.mode = model::CommandMode::Damping;  // start-up: the first command is still on its way
         ++startup_ticks;

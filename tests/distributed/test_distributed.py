@@ -31,6 +31,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
 
 from stack_layout import BIN, HOSTS, PLACEMENT, REPO, SCENARIOS, SUPERVISOR  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import SimLog, run_tests  # noqa: E402
 CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
 PERMITTED, WHY_NOT = netns_permitted()
 # Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/distributed.md):
@@ -221,9 +223,13 @@ class DistributedTest(unittest.TestCase):
         net, stack = self.network(domain)
         record = self.tmp / "cut.rawlog"
         st = self.up(self.scenario(CUT_SCENARIO), domain, stack, "--mode", "realtime", "--record", record)
-        time.sleep(3.0)
+        sim_log = SimLog(Path(st["run_dir"]) / "mft-sim.log")
+        sim_log.wait_for_sim_time(3.0)  # standing, settled
         cut_lo, cut_hi = net.cut("ctrl", 0.2)
-        time.sleep(2.5)
+        # Until the robot stands again with commands on every tick for a whole second (the progress lines come
+        # every second of sim time, so one second after the newest line the link is certainly back). The test
+        # used to sleep 2.5 s and then assert the height; 30 s only guards against a hang.
+        sim_log.wait_for_commands_flowing(sim_log.sim_time() + 1.0, timeout=30, base_z=STAND_HEIGHT_M, z_tol=0.01)
         s = self.down(domain, st)
         sim, rec = s["mft-sim"], s["mft-record"]
         onset, late_ms, duration_ms = max(sim["damping_episodes"], key=lambda e: e[2])
@@ -332,22 +338,35 @@ class DistributedTest(unittest.TestCase):
         rates = self.link_rates(b0, b1, 2.0)
         need_kbit = rates["robot"]["tx_kBps"] * 8
         limit_kbit = int(need_kbit * 0.5)  # half of what the simulator sends
+        sim_log = SimLog(Path(st["run_dir"]) / "mft-sim.log")
         with realtime_priority():
             net.set_rate("robot", f"{limit_kbit}kbit", burst="16kb", latency="5ms")
             time.sleep(1.0)
             limited = net.rate_stats("robot")
             net.clear_rate("robot")
-        time.sleep(2.0)
+        # Commands flow again once the limit is gone: wait for a whole second of sim time without damping after
+        # it (progress lines come every second, so one second after the newest line the limit is certainly off).
+        # The test used to sleep 2 s and assert that the last damping episode ended 0.5 s before the stack was
+        # stopped. With the other core busy that failed (last episode ended at 6.777 s, asserted 6.666 s): on a
+        # loaded machine a single late command is a damping episode of its own, at any time (one run: 11 episodes
+        # of 1-30 ms in 18 s, before and after the limit, docs/testing.md), so also in those last 0.5 s. What
+        # holds under load is that the chain answers every tick again for a sustained stretch; 30 s only guards
+        # against a hang (the test prints when the stretch ended; docs/testing.md).
+        cleared_after_s = sim_log.sim_time() + 1.0
+        flowing_s = sim_log.wait_for_commands_flowing(cleared_after_s, timeout=30)
         s = self.down(domain, st)
         sim = s["mft-sim"]
         log(f"\nlink rates (kB/s) {rates}; tbf {limit_kbit} kbit/s on robot for 1 s: {limited}; simulator: deadline "
             f"misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, episodes {sim['damping_episodes']}, "
-            f"fell {sim['fell']} {sim.get('fall_reason', '')}")
+            f"fell {sim['fell']} {sim.get('fall_reason', '')}; limit off before t = {cleared_after_s:.1f} s, a second "
+            f"without damping ended at t = {flowing_s:.1f} s")
         self.assertGreater(limited["dropped"], 0, limited)               # the limit bit
         self.assertGreaterEqual(sim["deadline_misses"], 1, sim)          # and the simulator noticed
-        onset, _, duration_ms = sim["damping_episodes"][-1]              # commands flowed again at the end
-        self.assertLess(onset + duration_ms * 1e-3, sim["sim_time_s"] - 0.5, sim["damping_episodes"])
+        # The summary agrees with the log: no damping episode in the second the log showed free of damping.
+        for onset, _, duration_ms in sim["damping_episodes"]:
+            end = onset + duration_ms * 1e-3 if duration_ms >= 0 else sim["sim_time_s"]
+            self.assertFalse(onset < flowing_s and end > flowing_s - 1.0, (flowing_s, sim["damping_episodes"]))
 
 
 if __name__ == "__main__":
-    unittest.main(verbosity=2)
+    run_tests()  # nice -10, failures printed as they happen (tests/simlog.py)

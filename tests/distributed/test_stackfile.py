@@ -15,6 +15,9 @@ import unittest
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import reserve_cpu_share  # noqa: E402
+
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
@@ -155,4 +158,5 @@ class StackFileTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main(verbosity=2)

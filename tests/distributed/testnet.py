@@ -51,6 +51,20 @@ def netns_exists(name):
     return Path("/run/netns", name).exists() or Path("/var/run/netns", name).exists()
 
 
+def remove_stale_namespaces():
+    """Deletes namespaces mftd<pid>-... of test processes that are gone: a test killed by CTest's timeout
+    (SIGKILL) never reaches its tearDown. Returns the names deleted."""
+    deleted = []
+    for d in (Path("/run/netns"), Path("/var/run/netns")):
+        for entry in sorted(d.glob("mftd*-*")) if d.is_dir() else []:
+            pid = entry.name[4:].split("-", 1)[0]
+            if not pid.isdigit() or Path("/proc", pid).exists():
+                continue
+            if subprocess.run(["ip", "netns", "del", entry.name], capture_output=True, timeout=30).returncode == 0:
+                deleted.append(entry.name)
+    return deleted
+
+
 def netns_permitted(probe_name=None):
     """(True, "") when this process may create network namespaces, else (False, why)."""
     if os.geteuid() != 0:
@@ -109,6 +123,7 @@ class TestNet:
     @classmethod
     def for_test(cls, tag, host_names, third_octet):
         """Namespaces named mftd<pid>-<tag>-<host> on 10.77.<third_octet>.0/24 (hosts .1, .2, ...)."""
+        remove_stale_namespaces()
         base = f"mftd{os.getpid()}-{tag}"
         hosts = {h: (f"{base}-{h}", f"10.77.{third_octet}.{i + 1}") for i, h in enumerate(host_names)}
         return cls(hosts, f"{base}-sw")

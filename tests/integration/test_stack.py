@@ -13,6 +13,9 @@ import time
 import unittest
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import SimLog, reserve_cpu_share  # noqa: E402
+
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
@@ -117,11 +120,12 @@ class StackTest(unittest.TestCase):
         code, out, err = self.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode", "realtime",
                                          timeout=120)
         self.assertEqual(code, 0, err)
-        time.sleep(2.0)
         st = json.loads(subprocess.run([sys.executable, str(SUPERVISOR), "status", "--domain", str(domain), "--json"],
                                        env=self.env, capture_output=True, text=True, timeout=30).stdout)
         wbc_pid = st["services"]["mft-wbc"]["pid"]
         run_dir = Path(st["run_dir"])
+        sim_log = SimLog(run_dir / "mft-sim.log")
+        sim_log.wait_for_sim_time(2.0)  # standing
         os.kill(wbc_pid, signal.SIGKILL)
         deadline = time.time() + 20
         restarted = False
@@ -130,7 +134,8 @@ class StackTest(unittest.TestCase):
             log = (run_dir / "mft-wbc.log").read_text(errors="replace")
             restarted = log.count("READY mft-wbc") >= 2
         self.assertTrue(restarted, "the supervisor did not restart mft-wbc")
-        time.sleep(1.5)  # commands flow again
+        # Commands flow again: a whole second of sim time without damping after the restart (not a fixed sleep).
+        sim_log.wait_for_commands_flowing(sim_log.sim_time(), timeout=30)
         code, out, err = self.supervisor("down", "--domain", domain, timeout=60)
         self.domain_used.remove(domain)
         self.assertEqual(code, 0, err)
@@ -175,4 +180,5 @@ class StackTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main(verbosity=2)

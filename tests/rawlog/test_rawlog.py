@@ -17,6 +17,9 @@ import time
 import unittest
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import SimLog, fifo_priority, reserve_cpu_share  # noqa: E402
+
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
@@ -280,18 +283,17 @@ class KilledRecorder(unittest.TestCase):
         code, out, err = self.tmp.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode",
                                              "realtime", "--record", rawlog, timeout=120)
         self.assertEqual(code, 0, err)
-        time.sleep(3.0)
         st = json.loads(run([sys.executable, SUPERVISOR, "status", "--domain", domain, "--json"],
                             env=self.tmp.env).stdout)
         pid = st["services"]["mft-record"]["pid"]
         run_dir = Path(st["run_dir"])
+        sim_log, rec_log = SimLog(run_dir / "mft-sim.log"), SimLog(run_dir / "mft-record.log")
+        sim_log.wait_for_sim_time(3.0)  # the recorder started before the clock: it has recorded >= 3 s
         t_kill = time.time()
         os.kill(pid, signal.SIGKILL)
-        deadline = time.time() + 20
-        while time.time() < deadline and \
-                (run_dir / "mft-record.log").read_text(errors="replace").count("READY mft-record") < 2:
-            time.sleep(0.1)
-        time.sleep(1.5)
+        rec_log.wait_for(lambda: rec_log.text().count("READY mft-record") >= 2, 20, "the recorder restarted (READY)")
+        # The new piece must hold more than 500 ticks: wait for 2 s of sim time after the restart was ready.
+        sim_log.wait_for_sim_time(sim_log.sim_time() + 2.0)
         code, out, err = self.tmp.supervisor("down", "--domain", domain, timeout=60)
         self.tmp.domains_up.remove(domain)
         self.assertEqual(code, 0, err)
@@ -343,24 +345,24 @@ class StarvedRecorder(unittest.TestCase):
         sup = subprocess.Popen(cmd, env=self.tmp.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.tmp.procs.append(sup)
         # Wait until the recorder is recording, then take its CPU away for 1.5 s.
-        log = run_dir / "mft-record.log"
-        deadline = time.time() + 60
-        while time.time() < deadline and not (log.exists() and "READY mft-record" in log.read_text(errors="replace")):
-            time.sleep(0.05)
+        rec_log, sim_log = SimLog(run_dir / "mft-record.log"), SimLog(run_dir / "mft-sim.log")
+        rec_log.wait_for(lambda: "READY mft-record" in rec_log.text(), 60, "the recorder ready (READY)")
         # The recorder this test's supervisor started (its own domain id is in the command line).
         found = subprocess.run(["pgrep", "-P", str(sup.pid), "-f", f"mft-record --domain {domain} "],
                                capture_output=True, text=True).stdout.split()
         self.assertEqual(len(found), 1, f"recorder of domain {domain} not found")
         pid = int(found[0])
-        time.sleep(0.5)
-        os.kill(pid, signal.SIGSTOP)
-        self.stopped.append(pid)
+        sim_log.wait_for_sim_time(1.0)  # the recorder is recording
         # Shorter than the participant lease (1 s, config/dds_profiles.xml): a recorder stopped for longer
         # finds the other participants expired when it resumes and drops their queued samples until they
-        # announce themselves again (docs/recording.md), which no flow control can prevent.
-        time.sleep(0.5)
-        os.kill(pid, signal.SIGCONT)
-        self.stopped.remove(pid)
+        # announce themselves again (docs/recording.md), which no flow control can prevent. Timed at SCHED_FIFO
+        # 85: a normal-priority sleep of 0.5 s can last past the lease on a busy machine.
+        with fifo_priority():
+            self.stopped.append(pid)
+            os.kill(pid, signal.SIGSTOP)
+            time.sleep(0.5)
+            os.kill(pid, signal.SIGCONT)
+            self.stopped.remove(pid)
         out, err = sup.communicate(timeout=300)
         sim_log = (run_dir / "mft-sim.log").read_text(errors="replace") if (run_dir / "mft-sim.log").exists() else ""
         self.assertEqual(sup.returncode, 0, err[-2000:] + sim_log[-2000:])
@@ -391,4 +393,5 @@ def tearDownModule():
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main()

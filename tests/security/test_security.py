@@ -9,9 +9,11 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 import unittest
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from simlog import SimLog, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
@@ -19,6 +21,15 @@ MAKE = REPO / "scripts" / "make-security.sh"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
 SCENARIOS = REPO / "config" / "scenarios"
 DOMAIN = 220
+# How long a new secured participant may take to match the stack's writers: the supervisor's own bound for a
+# secured chain to connect (SECURE_START_TIMEOUT_S in services/mft-supervisor), past which Fast DDS's handshake
+# is taken as stuck. On an idle machine it takes 0.3-1.2 s.
+SECURE_MATCH_TIMEOUT_S = 10
+# Fast DDS 2.9.1's handshake between two participants sometimes never completes (docs/security.md; seen here
+# with the other core busy: a new participant of the recorder's identity matched neither the simulator's nor
+# the WBC's writer within 10 s). The supervisor then starts a new participant (SECURE_RUN_ATTEMPTS = 2), which
+# authenticates afresh; the test does the same with its listener, at most this many times, and says so.
+SECURE_MATCH_ATTEMPTS = 3
 
 
 class SecurityTest(unittest.TestCase):
@@ -76,7 +87,8 @@ class SecurityTest(unittest.TestCase):
                 for n in ("mft-sim", "mft-wbc", "mft-estimator", "mft-planner")}
 
     def inject(self, *args, timeout=60):
-        cmd = [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
+        # At SCHED_FIFO just below the stack (tests/simlog.py): a listener's counts do not depend on the load.
+        cmd = helper_realtime_prefix() + [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.procs.append(p)
         out, err = p.communicate(timeout=timeout)
@@ -89,7 +101,7 @@ class SecurityTest(unittest.TestCase):
     def test_secured_stack_refuses_strangers_and_unpermitted_writers(self):
         domain = DOMAIN
         st = self.up(domain, "stand.yaml", "--secure", self.sec)
-        time.sleep(1.0)
+        SimLog(Path(st["run_dir"]) / "mft-sim.log").wait_for_sim_time(1.0)
         # (1) No identity at all: nothing matches, nothing arrives, on any topic.
         code, r = self.inject("--domain", domain, "--listen", "all", "--seconds", 3)
         self.assertEqual(code, 0, r)
@@ -101,10 +113,24 @@ class SecurityTest(unittest.TestCase):
         self.assertEqual(code, 0, r)
         self.assertEqual(sum(t["received"] for t in r["listen"].values()), 0, r)
         # (3) The recorder's valid identity receives: the secured topics do flow (the test can see data). The
-        # secure handshake takes 0.3-1.2 s on this machine before the first sample; from then on every tick
-        # arrives.
-        code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "record",
-                              "--listen", "SensorData,JointCommand", "--seconds", 3)
+        # secure handshake with each of the stack's participants must finish before a reader matches: 0.3-1.2 s
+        # on an idle machine, longer with the CPU busy (public-key operations at normal priority beside a
+        # SCHED_FIFO stack). A fixed 3 s window that included it failed once under load with the JointCommand
+        # reader never matched; the window now starts once both readers have a writer (bounded), and from then
+        # on every tick arrives.
+        for attempt in range(1, SECURE_MATCH_ATTEMPTS + 1):
+            code, r = self.inject("--domain", domain, "--secure", self.sec, "--identity", "record",
+                                  "--listen", "SensorData,JointCommand", "--wait-writers", SECURE_MATCH_TIMEOUT_S,
+                                  "--seconds", 3)
+            if r["writers_matched_after_s"] >= 0.0:
+                break
+            print(f"\nrecorder identity, participant {attempt}: no writer matched on every topic within "
+                  f"{SECURE_MATCH_TIMEOUT_S} s (stuck secure handshake): {r['listen']}", file=sys.stderr)
+        self.assertGreaterEqual(r["writers_matched_after_s"], 0.0,
+                                f"the recorder identity's readers had no matched writer on every topic within "
+                                f"{SECURE_MATCH_TIMEOUT_S} s, with {SECURE_MATCH_ATTEMPTS} new participants "
+                                f"(secure handshake not finished): {r}")
+        handshake_s = r["writers_matched_after_s"]
         for topic in ("SensorData", "JointCommand"):
             t = r["listen"][topic]
             self.assertGreater(t["received"], 1000, r)
@@ -138,14 +164,15 @@ class SecurityTest(unittest.TestCase):
         self.assertLess(abs(sim["final_base_height_m"] - 0.40), 0.01)
         print(f"\nsecured stack: stranger listened 0 samples, stranger wrote {r['written']} JointCommands, sim received "
               f"{sim['commands_received']} commands for {wbc['ticks']} WBC ticks, final base height "
-              f"{sim['final_base_height_m']:.4f} m", file=sys.stderr)
+              f"{sim['final_base_height_m']:.4f} m; the recorder identity matched after {handshake_s:.2f} s "
+              f"(participant {attempt})", file=sys.stderr)
 
     def test_plain_stack_would_take_the_strangers_commands(self):
         # The same stranger on a stack without --secure: its commands do reach the simulator. This is what
         # the secured test above rules out, and shows that the test would see an effect.
         domain = DOMAIN + 1
         st = self.up(domain, "stand.yaml")
-        time.sleep(1.0)
+        SimLog(Path(st["run_dir"]) / "mft-sim.log").wait_for_sim_time(1.0)
         code, r = self.inject("--domain", domain, "--publish", "JointCommand", "--value", "40", "--rate", 1000,
                               "--seconds", 1, "--wait-match", 5)
         self.assertGreater(r["matched_readers"], 0, r)
@@ -154,9 +181,10 @@ class SecurityTest(unittest.TestCase):
         self.assertGreater(sim["commands_received"] - wbc["ticks"], 500, (sim["commands_received"], wbc["ticks"]))
 
     def test_secured_stack_steps_in_place_in_lockstep(self):
+        run_dir = self.tmp / "run-lockstep"
         code, out, err = self.sup("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
-                                  "--json", "--run-dir", self.tmp / "run-lockstep")
-        self.assertEqual(code, 0, err[-3000:])
+                                  "--json", "--run-dir", run_dir)
+        self.assertEqual(code, 0, err[-3000:] + "\nmft-sim.log:\n" + SimLog(run_dir / "mft-sim.log").text()[-3000:])
         s = json.loads(out)
         self.assertTrue(s["secure"])
         self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))
@@ -198,4 +226,5 @@ class SecurityTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
+    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
     unittest.main(verbosity=2)

@@ -53,12 +53,24 @@ t0 = time.monotonic()
 run_for = float(behaviour.get("run_for", "1e9"))
 crash_after = float(behaviour.get("crash_after", "1e9"))
 crash_times = int(behaviour.get("crash_times", "1000"))
+# until_started=SERVICE/N: end (before run_for) once SERVICE has been started N times, so that a run lasts as
+# long as the restarts it tests take, not a fixed time that a loaded machine may not give them.
+until_service, _, until_count = behaviour.get("until_started", "/0").partition("/")
+
+
+def started(service):
+    try:
+        return sum(1 for l in Path(os.environ["FAKE_PID_LOG"]).read_text().splitlines() if l.split()[0] == service)
+    except OSError:
+        return 0
+
+
 while not stop:
     t = time.monotonic() - t0
     if t > crash_after and crashes < crash_times:
         crash_file.write_text(str(crashes + 1))
         os._exit(3)
-    if t > run_for:
+    if t > run_for or (until_service and started(until_service) >= int(until_count)):
         break
     time.sleep(0.01)
 summary = {"service": name, "ran_s": time.monotonic() - t0}

@@ -1,6 +1,8 @@
 // mft-inject: a test participant for the security tests and the fault matrix (docs/security.md, docs/faults.md).
 //  --listen TOPICS        joins the domain (with no identity, or --secure DIR --identity NAME), subscribes and
 //                         counts samples per topic: matched writers, received, non-finite samples, largest gap.
+//                         With --wait-writers S it first waits (at most S seconds) until every listened topic has a
+//                         matched writer, so that a slow discovery or secure handshake does not eat the window.
 //  --publish TOPIC        publishes on TOPIC: values from --value (nan, inf, -inf, range, or a number) in the
 //                         --field fields (default all floating-point fields). With --follow it copies every
 //                         real sample of TOPIC and re-publishes it corrupted at once, its tick advanced by
@@ -322,8 +324,10 @@ int main(int argc, char** argv) {
   cli.flag("follow", "re-publish every real sample of the --publish topic corrupted, at once");
   cli.option("tick-offset", "with --follow: add this to the copied tick (1: the corrupted sample is the newest)", "1");
   cli.option("rate", "without --follow: samples per second", "1000");
-  cli.option("seconds", "how long to listen / publish", "3");
+  cli.option("seconds", "how long to listen / publish (a listener alone stops early, and reports, on SIGTERM)", "3");
   cli.option("wait-match", "seconds to wait for a matching reader before publishing (0: do not wait)", "5");
+  cli.option("wait-writers", "with --listen: seconds to wait until every listened topic has a matched writer before "
+             "the --seconds window starts (0: do not wait)", "0");
   cli.option("profiles", "DDS QoS profile file", MFT_DDS_PROFILES);
   cli.flag("json", "print the report as JSON");
   cli.parse(argc, argv);
@@ -331,6 +335,7 @@ int main(int argc, char** argv) {
   const int domain = static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId));
   const double seconds = cli.getDouble("seconds", 0.0, 3600.0);
   const double wait_match = cli.getDouble("wait-match", 0.0, 600.0);
+  const double wait_writers = cli.getDouble("wait-writers", 0.0, 600.0);
   const double rate = cli.getDouble("rate", 0.1, 100000.0);
   const auto tick_offset = static_cast<std::int64_t>(cli.getInt("tick-offset", -1000000, 1000000000));
   const std::vector<std::string> listen = cli.isSet("listen") ? splitTopics(cli.get("listen"), cli) : std::vector<std::string>{};
@@ -362,7 +367,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<Publisher> publisher;
   std::unique_ptr<services::DdsParticipant> participant;
   int exit_code = 0;
-  double matched_after_s = -1.0;
+  double matched_after_s = -1.0, writers_matched_after_s = -1.0;
   try {
     participant = std::make_unique<services::DdsParticipant>(domain, cli.get("profiles"), "mft-inject", security);
   } catch (const services::DdsError& e) {
@@ -420,11 +425,30 @@ int main(int argc, char** argv) {
       });
     }
   }
+  // A pure listener ends its window early on SIGTERM/SIGINT and still reports (a test stops it when its fault
+  // is over, so that the window covers the fault exactly).
+  if (participant && !publisher) services::installShutdownHandlers();
   const auto t0 = Clock::now();
   if (publisher && wait_match > 0) {
     if (services::waitUntil([&] { return publisher->matched() > 0; },
                             std::chrono::milliseconds(static_cast<long>(wait_match * 1000))))
       matched_after_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+  if (!listeners.empty() && wait_writers > 0) {
+    // A secured participant matches only after its authentication handshake with each remote participant,
+    // which takes longer on a loaded machine: the counting window starts once every topic has a writer.
+    auto all_matched = [&] {
+      for (const auto& [t, l] : listeners)
+        if (l->matched() == 0) return false;
+      return true;
+    };
+    if (services::waitUntil([&] { return all_matched() || services::shutdownRequested(); },
+                            std::chrono::milliseconds(static_cast<long>(wait_writers * 1000))) && all_matched())
+      writers_matched_after_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    // A test that must act while this participant counts waits for this line (the report comes at the end).
+    std::printf("mft-inject: counting from now (%s)\n",
+                writers_matched_after_s >= 0 ? "every listened topic has a writer" : "a listened topic has no writer");
+    std::fflush(stdout);
   }
   const auto start = Clock::now();
   const auto end = start + std::chrono::duration<double>(seconds);
@@ -439,7 +463,8 @@ int main(int argc, char** argv) {
         std::this_thread::sleep_until(next);
       }
     } else {
-      std::this_thread::sleep_until(end);
+      while (Clock::now() < end && !services::shutdownRequested())
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));  // the window may end up to 10 ms late
     }
   }
   // Reliable event writers: a moment for the acknowledgement before the participant goes.
@@ -471,11 +496,11 @@ int main(int argc, char** argv) {
   if (json) {
     std::printf("{\"domain\": %d, \"identity\": %s, \"participant\": %s, \"publish\": %s, \"writer\": %s, "
                 "\"value\": %s, \"follow\": %s, \"matched_readers\": %d, \"matched_after_s\": %.3f, \"written\": %llu, "
-                "\"listen\": %s, \"error\": %s}\n",
+                "\"writers_matched_after_s\": %.3f, \"listen\": %s, \"error\": %s}\n",
                 domain, security.enabled() ? jsonString(security.identity).c_str() : "null",
                 jsonString(participant_status).c_str(), jsonString(publish_topic).c_str(), jsonString(writer_status).c_str(),
                 jsonString(cli.get("value")).c_str(), follow ? "true" : "false", matched_readers, matched_after_s, written,
-                listen_json.c_str(), jsonString(error).c_str());
+                writers_matched_after_s, listen_json.c_str(), jsonString(error).c_str());
   } else {
     std::printf("mft-inject: domain %d, identity %s: participant %s\n", domain,
                 security.enabled() ? security.identity.c_str() : "(none)", participant_status.c_str());

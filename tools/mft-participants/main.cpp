@@ -24,7 +24,7 @@
 
 namespace {
 
-namespace dds = eprosima::fastdds::dds;
+namespace fdds = eprosima::fastdds::dds;
 using eprosima::fastrtps::rtps::IPLocator;
 using eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
 using Clock = std::chrono::steady_clock;
@@ -53,11 +53,11 @@ std::string jsonString(const std::string& s) {
   return out + "\"";
 }
 
-class DiscoveryListener : public dds::DomainParticipantListener {
+class DiscoveryListener : public fdds::DomainParticipantListener {
  public:
   explicit DiscoveryListener(Clock::time_point t0) : t0_(t0) {}
 
-  void on_participant_discovery(dds::DomainParticipant*, ParticipantDiscoveryInfo&& info) override {
+  void on_participant_discovery(fdds::DomainParticipant*, ParticipantDiscoveryInfo&& info) override {
     std::ostringstream guid;
     guid << info.info.m_guid.guidPrefix;
     std::lock_guard<std::mutex> lock(mutex_);
@@ -101,8 +101,8 @@ int main(int argc, char** argv) {
       "addresses). The supervisor uses it to refuse a domain that is already in use.");
   cli.option("domain", "DDS domain id (0..232)", "", true);
   cli.option("profiles", "DDS QoS profile file (its participant profile mft_participant is used)", MFT_DDS_PROFILES);
-  cli.option("wait-ms", "how long to listen for participants [ms] (docs/faults.md: discovery on loopback takes "
-             "a few ms; the supervisor's bound has a wide margin)", "300");
+  cli.option("wait-ms", "how long to listen for participants [ms] (docs/faults.md: discovery on loopback took "
+             "92-368 ms on a loaded 2-core VM)", "1000");
   cli.flag("stop-at-first", "return as soon as one participant is discovered");
   cli.flag("json", "print JSON");
   cli.parse(argc, argv);
@@ -113,14 +113,14 @@ int main(int argc, char** argv) {
   // Fast DDS's XML errors would otherwise be printed as coloured log lines; report them as one line.
   const std::string problem = mft::services::checkProfilesFile(profiles);
   if (!problem.empty()) cli.fail(problem);
-  auto* factory = dds::DomainParticipantFactory::get_instance();
-  dds::DomainParticipantQos qos;
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  fdds::DomainParticipantQos qos;
   if (factory->get_participant_qos_from_profile("mft_participant", qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
     cli.fail(profiles + ": no participant profile 'mft_participant'");
   qos.name("mft-participants");
   const auto t0 = Clock::now();
   DiscoveryListener listener(t0);
-  dds::DomainParticipant* participant = factory->create_participant(domain, qos, &listener, dds::StatusMask::none());
+  fdds::DomainParticipant* participant = factory->create_participant(domain, qos, &listener, fdds::StatusMask::none());
   if (!participant) {
     std::fprintf(stderr, "mft-participants: cannot create a DDS participant on domain %d\n", domain);
     return 3;

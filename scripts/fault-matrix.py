@@ -501,4 +501,16 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # One line instead of a traceback for what a user can cause (issue 16): Ctrl-C, an unwritable or full
+    # output folder, a file that is not UTF-8.
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:
+        print("fault-matrix.py: interrupted", file=sys.stderr)
+        sys.exit(130)
+    except UnicodeDecodeError as e:
+        print(f"fault-matrix.py: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
+        sys.exit(2)
+    except OSError as e:
+        print(f"fault-matrix.py: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
+        sys.exit(2)

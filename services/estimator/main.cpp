@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
+  if (ctx.checkOnly()) return ctx.reportConfigOk();
   config.mode = ctx.scenario().estimator == "ground_truth" ? estimator::EstimatorMode::GroundTruth
                                                           : estimator::EstimatorMode::Kalman;
   estimator::StateEstimator estimator(config, ctx.robot());

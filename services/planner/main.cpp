@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
+  if (ctx.checkOnly()) return ctx.reportConfigOk();
   planner::MotionPlanner& planner = *planner_ptr;
   planner::PlannerStateBuilder state_builder(ctx.robot());
 

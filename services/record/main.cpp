@@ -57,12 +57,7 @@ std::string utcNow() {
 }
 
 void writeSummary(const std::string& path, const std::string& json) {
-  if (path.empty()) return;
-  {
-    std::ofstream out(path + ".tmp");
-    out << json << "\n";
-  }
-  std::rename((path + ".tmp").c_str(), path.c_str());  // never a half-written summary
+  services::writeSummaryFile(path, json, "mft-record");
 }
 
 // CPU seconds used so far by this process's threads, summed by thread name (the DDS receive threads versus
@@ -134,6 +129,24 @@ int firstPiece(const std::string& output) {
   int piece = 1;
   while (fs::exists(rawlog::pieceName(output, piece))) ++piece;
   return piece;
+}
+
+// A recording is never replaced silently: an existing --output (or its sidecar) is refused unless --overwrite,
+// which removes the old sidecar and pieces too, so that nothing of the old recording is read with the new one.
+// (A recorder restarted by the supervisor continues in a new piece instead: firstPiece() > 0.)
+void refuseOrClearOldRecording(const std::string& output, bool overwrite, bool check_only,
+                               const services::CommandLine& cli) {
+  const std::string sidecar = rawlog::sidecarName(output);
+  std::error_code ec;
+  const bool exists = fs::exists(output, ec) || fs::exists(sidecar, ec);
+  if (!exists) return;
+  if (!overwrite)
+    cli.fail(output + " already exists: refusing to replace a recording (--overwrite replaces it)");
+  if (fs::is_directory(output, ec)) cli.fail("--output " + output + " is a directory");
+  if (check_only) return;  // --check-config changes nothing
+  fs::remove(output, ec);
+  fs::remove(sidecar, ec);
+  for (int piece = 1; fs::exists(rawlog::pieceName(output, piece), ec); ++piece) fs::remove(rawlog::pieceName(output, piece), ec);
 }
 
 namespace dds = eprosima::fastdds::dds;
@@ -255,7 +268,8 @@ int main(int argc, char** argv) {
                             "Records every topic to an MRPT rawlog (observations-only format, standard classes,\n"
                             "metadata comment first, sidecar FILE.yaml). See docs/recording.md.");
   services::ServiceContext::declareOptions(cli);
-  cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>)", "", true);
+  cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>); an existing recording is refused", "", true);
+  cli.flag("overwrite", "replace an existing recording at --output (its sidecar and pieces too)");
   cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (RAWLOG.md)", "1");
   cli.option("flush-ms", "flush period: a crash loses about this much [ms] (at most 100)", "50");
   cli.option("queue", "capacity of the queue between DDS and the writer [messages]", "65536");
@@ -312,6 +326,7 @@ int main(int argc, char** argv) {
   opt.first_piece = firstPiece(opt.output);
   if (opt.first_piece > 0)
     std::printf("mft-record: restarted after a crash: continuing in %s\n", rawlog::pieceName(opt.output, opt.first_piece).c_str());
+  if (opt.first_piece == 0) refuseOrClearOldRecording(opt.output, cli.isSet("overwrite"), cli.isSet("check-config"), cli);
 
   // The effective configuration of every service: the files of --config-dir they read, the scenario and
   // its terrain, verbatim, so a recording can rebuild its controller (mft-replay --through-wbc).
@@ -331,6 +346,12 @@ int main(int argc, char** argv) {
   const std::string terrain = "terrain/" + scenario.terrain + ".yaml";
   if (fs::exists(config_file(terrain))) md.config[terrain] = readFile(config_file(terrain));
 
+  if (cli.isSet("check-config")) {
+    const std::string problem = services::checkProfilesFile(services::ServiceContext::profilesFile(cli));
+    if (!problem.empty()) cli.fail(problem);
+    std::printf("mft-record: configuration ok\n");
+    return 0;
+  }
   fs::create_directories(fs::path(opt.output).parent_path());
   rawlog::Recorder recorder(opt);
   try {

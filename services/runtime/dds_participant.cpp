@@ -1,12 +1,16 @@
 #include "services/runtime/dds_participant.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/log/Log.hpp>
+#include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <set>
+#include <vector>
 
 namespace mft::services {
 
@@ -33,6 +37,53 @@ void loadProfilesOnce(const std::string& file) {
   loaded.insert(file);
 }
 }  // namespace
+
+namespace {
+// Collects what Fast DDS logs while it parses a profile file: its XML parser names the refused element
+// only in its log, not in the return code.
+class CollectingLogConsumer : public eprosima::fastdds::dds::LogConsumer {
+ public:
+  explicit CollectingLogConsumer(std::vector<std::string>* lines) : lines_(lines) {}
+  void Consume(const eprosima::fastdds::dds::Log::Entry& entry) override {
+    if (entry.kind == eprosima::fastdds::dds::Log::Kind::Error) lines_->push_back(entry.message);
+  }
+
+ private:
+  std::vector<std::string>* lines_;
+};
+}  // namespace
+
+std::string checkProfilesFile(const std::string& profiles_file) {
+  using eprosima::fastdds::dds::Log;
+  if (!std::ifstream(profiles_file).good()) return profiles_file + ": cannot open the DDS profile file";
+  std::vector<std::string> errors;
+  Log::ClearConsumers();
+  Log::RegisterConsumer(std::make_unique<CollectingLogConsumer>(&errors));
+  auto* factory = DomainParticipantFactory::get_instance();
+  const bool loaded = factory->load_XML_profiles_file(profiles_file) == ReturnCode_t::RETCODE_OK;
+  Log::Flush();
+  Log::ClearConsumers();  // the collector points at a local; nothing more is logged in a check
+  std::string detail;
+  for (const auto& e : errors) detail += (detail.empty() ? "" : "; ") + e;
+  if (!loaded || !errors.empty())
+    return profiles_file + ": Fast DDS refused the profile file" + (detail.empty() ? "" : ": " + detail);
+  DomainParticipantQos participant_qos;
+  if (factory->get_participant_qos_from_profile("mft_participant", participant_qos) != ReturnCode_t::RETCODE_OK)
+    return profiles_file + ": no participant profile 'mft_participant'";
+  using eprosima::fastrtps::xmlparser::XMLP_ret;
+  using eprosima::fastrtps::xmlparser::XMLProfileManager;
+  for (const char* name : {"control_writer", "reliable_writer", "lockstep_writer", "event_writer"}) {
+    eprosima::fastrtps::PublisherAttributes attributes;
+    if (XMLProfileManager::fillPublisherAttributes(name, attributes, false) != XMLP_ret::XML_OK)
+      return profiles_file + ": no data_writer profile '" + name + "'";
+  }
+  for (const char* name : {"control_reader", "reliable_reader", "lockstep_reader", "event_reader"}) {
+    eprosima::fastrtps::SubscriberAttributes attributes;
+    if (XMLProfileManager::fillSubscriberAttributes(name, attributes, false) != XMLP_ret::XML_OK)
+      return profiles_file + ": no data_reader profile '" + name + "'";
+  }
+  return "";
+}
 
 DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
                                const SecurityOptions& security, const ReceiveTuning& receive)

@@ -10,6 +10,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "services/runtime/dds_security.hpp"
 #include "services/runtime/polling_udp_transport.hpp"
@@ -26,6 +27,12 @@ constexpr int kMaxDomainId = 232;
 
 // Validates a domain id, throwing DdsError with a message that names the valid range.
 int checkedDomainId(long domain_id);
+
+// `--check-config`: loads `profiles_file` with Fast DDS's own XML loader and checks that it defines the
+// participant profile "mft_participant" and every data_writer/data_reader profile the services use.
+// Returns "" when it is usable, else one line naming the file and what Fast DDS refused (its XML parser's
+// messages, which name the element). Creates no participant.
+std::string checkProfilesFile(const std::string& profiles_file);
 
 class DdsParticipant {
  public:

@@ -17,6 +17,8 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profiles", "DDS QoS profile file (default: dds_profiles.xml of --config-dir; a multi-host stack gives "
              "each host its own: its address, its peers or discovery server, docs/distributed.md)");
+  cli.flag("check-config", "load every configuration file this service reads (strict loaders) and the DDS profile "
+           "file (Fast DDS's XML loader), then exit: 0 and 'configuration ok', or 2 and the error; starts nothing");
 }
 
 std::string ServiceContext::profilesFile(const CommandLine& cli) {
@@ -38,6 +40,12 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
+  check_only_ = cli.isSet("check-config");
+  if (check_only_) {
+    const std::string problem = checkProfilesFile(profilesFile(cli));
+    if (!problem.empty()) cli.fail(problem);
+    return;
+  }
   if (cli.isSet("rt")) tryRealtimeScheduling(80);
   try {
     participant_ = std::make_unique<DdsParticipant>(domain, profilesFile(cli), service,
@@ -47,18 +55,33 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   }
 }
 
-void ServiceContext::writeSummary(const std::string& json) const {
-  if (summary_file_.empty()) return;
-  const std::string tmp = summary_file_ + ".tmp";
+int ServiceContext::reportConfigOk() const {
+  std::printf("%s: configuration ok\n", service_.c_str());
+  return 0;
+}
+
+void ServiceContext::writeSummary(const std::string& json) const { writeSummaryFile(summary_file_, json, service_); }
+
+void writeSummaryFile(const std::string& path, const std::string& json, const std::string& service) {
+  if (path.empty()) return;
+  const std::string tmp = path + ".tmp";
+  bool written = false;
   {
     std::ofstream out(tmp);
     out << json << "\n";
-    if (!out) {
-      std::fprintf(stderr, "%s: cannot write the summary %s\n", service_.c_str(), summary_file_.c_str());
-      return;
-    }
+    out.close();  // a full disk shows here, when the buffer is written
+    written = !out.fail();
   }
-  std::rename(tmp.c_str(), summary_file_.c_str());  // never a half-written summary
+  if (written) written = std::rename(tmp.c_str(), path.c_str()) == 0;  // never a half-written summary
+  if (written) return;
+  std::remove(tmp.c_str());
+  // The run's result must not be lost with the file (a full disk): the supervisor reads this line instead.
+  std::string line = json;
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  std::fprintf(stderr, "%s: cannot write the summary %s: printing it on stdout\n", service.c_str(), path.c_str());
+  std::printf("SUMMARY %s\n", line.c_str());
+  std::fflush(stdout);
 }
 
 }  // namespace mft::services

@@ -21,8 +21,15 @@ class ServiceContext {
   // The DDS profile file of a parsed command line: --profiles, else dds_profiles.xml of --config-dir.
   static std::string profilesFile(const CommandLine& cli);
   // After cli.parse(): loads the configuration and creates the participant. Exits 2 with a clear message on
-  // any configuration error (nothing is started).
+  // any configuration error (nothing is started). With --check-config it creates no participant but checks
+  // the DDS profile file with Fast DDS's XML loader instead.
   ServiceContext(const std::string& service, const CommandLine& cli);
+
+  // --check-config: the main loads its own configuration files with their strict loaders, then, instead of
+  // creating its endpoints, returns reportConfigOk() (prints "<service>: configuration ok", exit status 0).
+  // Errors exit 2 through cli.fail() as always. The supervisor runs this for every service before it starts any.
+  bool checkOnly() const { return check_only_; }
+  int reportConfigOk() const;
 
   const std::string& service() const { return service_; }
   LoopMode mode() const { return mode_; }
@@ -42,6 +49,7 @@ class ServiceContext {
 
  private:
   std::string service_;
+  bool check_only_ = false;
   LoopMode mode_ = LoopMode::Lockstep;
   std::string config_dir_;
   std::string summary_file_;
@@ -49,5 +57,9 @@ class ServiceContext {
   Scenario scenario_;
   std::unique_ptr<DdsParticipant> participant_;
 };
+
+// Writes `json` to `path` (never half-written). When that fails (a full disk), prints it on stdout as one line
+// "SUMMARY {...}", which the supervisor reads from the service's output instead. Never throws.
+void writeSummaryFile(const std::string& path, const std::string& json, const std::string& service);
 
 }  // namespace mft::services

@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
+  if (ctx.checkOnly()) return ctx.reportConfigOk();
   sim::Simulator simulator(ctx.robot(), options, terrain);
   sim::StandingPose pose;
   pose.base_height_m = scenario.initial_base_height_m;

@@ -83,6 +83,7 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     cli.fail(e.what());
   }
+  if (ctx.checkOnly()) return ctx.reportConfigOk();
   wbc::WholeBodyController& controller = *controller_ptr;
   const std::string dump_dir = cli.get("dump-qp");
   const auto dump_ticks = parseTicks(cli.get("dump-ticks"), cli);

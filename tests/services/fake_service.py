@@ -18,6 +18,24 @@ def opt(key, default=None):
     return args[args.index(key) + 1] if key in args else default
 
 
+if name == "mft-participants":
+    # The supervisor's domain probe: the participants listed in $FAKE_PARTICIPANTS (a JSON list) answer.
+    print(json.dumps({"domain": int(opt("--domain")), "participants": json.loads(os.environ.get("FAKE_PARTICIPANTS", "[]"))}))
+    sys.exit(0)
+
+if "--check-config" in args:
+    # FAKE_CHECK_CONFIG="mft-wbc=message": that service refuses its configuration with the message.
+    for spec in filter(None, os.environ.get("FAKE_CHECK_CONFIG", "").split(",")):
+        service, message = spec.split("=", 1)
+        if service == name:
+            print(f"{name}: {message}\nTry '{name} --help'.", file=sys.stderr)
+            sys.exit(2)
+    with open(os.environ["FAKE_PID_LOG"] + ".checks", "a") as f:
+        f.write(f"{name} {os.getpid()}\n")
+    time.sleep(float(os.environ.get("FAKE_CHECK_SLOW", "0")))  # a slow validation (Ctrl-C during it)
+    print(f"{name}: configuration ok")
+    sys.exit(0)
+
 if "--check-scenario" in args:
     path = Path(opt("--check-scenario"))
     text = path.read_text()
@@ -48,6 +66,10 @@ def on_term(*_):
 
 signal.signal(signal.SIGTERM, on_term)
 signal.signal(signal.SIGINT, on_term)
+if "fail_start" in behaviour:  # exits before it is ready, with this message
+    print(f"{name}: {behaviour['fail_start']}", flush=True)
+    sys.exit(3)
+time.sleep(float(behaviour.get("ready_after", "0")))  # a slow start (Ctrl-C at spawn)
 print(f"READY {name}", flush=True)
 t0 = time.monotonic()
 run_for = float(behaviour.get("run_for", "1e9"))
@@ -78,4 +100,8 @@ if name == "mft-sim":
     summary.update({"fell": False, "sim_time_s": 1.0, "ticks": 1000, "deadline_misses": 0})
 if name == "mft-wbc":
     summary.update({"solve_time_us": {"mean": 5.0, "p99": 9.0, "max": 20.0}, "safety_events": 0})
-summary_path.write_text(json.dumps(summary))
+try:
+    summary_path.write_text(json.dumps(summary))
+except OSError as e:  # as the real services do (ServiceContext::writeSummary): the summary on stdout instead
+    print(f"{name}: cannot write the summary {summary_path}: {e.strerror}", file=sys.stderr)
+    print("SUMMARY " + json.dumps(summary), flush=True)

@@ -20,6 +20,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent.parent
 SUPERVISOR = REPO / "services" / "mft-supervisor"
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
+TOOLS = ["mft-participants"]  # the domain probe (the fake lists the participants of $FAKE_PARTICIPANTS)
 
 
 def pid_alive(pid):
@@ -34,12 +35,14 @@ def pid_alive(pid):
         return False
 
 
-class SupervisorTest(unittest.TestCase):
+class FakeStack:
+    """A temporary bin folder of fake services, a copy of config/, a quick scenario, and cleanup by pid."""
+
     def setUp(self):
         self.tmp = Path(tempfile.mkdtemp(prefix="mft-sup-test-"))
         self.bin = self.tmp / "bin"
         self.bin.mkdir()
-        for s in SERVICES:
+        for s in SERVICES + TOOLS:
             (self.bin / s).symlink_to(HERE / "fake_service.py")
         self.cfg = self.tmp / "config"
         shutil.copytree(REPO / "config", self.cfg, ignore=shutil.ignore_patterns("scenarios"))
@@ -67,14 +70,16 @@ class SupervisorTest(unittest.TestCase):
             return []
         return [int(l.split()[1]) for l in self.pid_log.read_text().splitlines()]
 
-    def supervisor(self, *args, fake="", timeout=60):
-        env = dict(self.env, FAKE_SERVICES=fake)
+    def supervisor(self, *args, fake="", timeout=60, **extra_env):
+        env = dict(self.env, FAKE_SERVICES=fake, **extra_env)
         cmd = [sys.executable, str(SUPERVISOR)] + list(args) + ["--bin-dir", str(self.bin), "--config-dir", str(self.cfg)]
         p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.procs.append(p)
         out, err = p.communicate(timeout=timeout)
         return p.returncode, out, err
 
+
+class SupervisorTest(FakeStack, unittest.TestCase):
     def test_run_ends_cleanly_with_a_summary(self):
         code, out, err = self.supervisor("run", str(self.scenario), "--domain", "7", "--json", fake="mft-sim:run_for=0.5")
         self.assertEqual(code, 0, err)
@@ -198,6 +203,204 @@ class SupervisorTest(unittest.TestCase):
         code, out, err = self.supervisor("run", str(self.scenario), "--domain", "12")
         self.assertIn("missing executables", err)
         self.assertEqual(self.started_pids(), [])
+
+
+class MisuseTest(FakeStack, unittest.TestCase):
+    """Bad input and misuse (issue 16, docs/faults.md "Bad input and misuse"): each is refused with one line
+    before anything starts, or handled without losing a result."""
+
+    def sup_cmd(self, *args):
+        return [sys.executable, str(SUPERVISOR)] + [str(a) for a in args] + ["--bin-dir", str(self.bin),
+                                                                              "--config-dir", str(self.cfg)]
+
+    def plain(self, *args, env=None):
+        return subprocess.run([sys.executable, str(SUPERVISOR)] + [str(a) for a in args], env=env or self.env,
+                              capture_output=True, text=True, timeout=60)
+
+    def assert_one_line_error(self, err, expect):
+        self.assertIn(expect, err)
+        self.assertNotIn("Traceback", err)
+
+    def test_a_busy_domain_is_refused_for_run_and_up(self):
+        others = json.dumps([{"name": "mft-wbc", "guid_prefix": "01.0f", "addresses": ["127.0.0.1"]},
+                             {"name": "mft-sim", "guid_prefix": "01.10", "addresses": ["127.0.0.1"]}])
+        for command in ("run", "up"):
+            code, out, err = self.supervisor(command, str(self.scenario), "--domain", "21", FAKE_PARTICIPANTS=others)
+            self.assertEqual(code, 2, (command, err))
+            self.assert_one_line_error(err, "domain 21 is in use: 2 DDS participant(s) answered: mft-wbc at 127.0.0.1")
+            self.assertIn("mft-sim at 127.0.0.1", err)
+        self.assertEqual(self.started_pids(), [])  # nothing started, not even for a moment
+        self.assertFalse((self.tmp / "runs" / "stack-d21.json").exists())
+
+    def test_record_never_replaces_an_existing_recording(self):
+        rec = self.tmp / "old.rawlog"
+        rec.write_bytes(b"an earlier recording")
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "22", "--record", str(rec),
+                                         fake="mft-sim:run_for=0.2")
+        self.assertEqual(code, 2, err)
+        self.assert_one_line_error(err, f"--record {rec}: {rec} already exists; refusing to replace a recording "
+                                        f"(--overwrite replaces it)")
+        self.assertEqual(rec.read_bytes(), b"an earlier recording")
+        self.assertEqual(self.started_pids(), [])
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "22", "--record", str(rec),
+                                         "--overwrite", "--json", fake="mft-sim:run_for=0.2")
+        self.assertEqual(code, 0, err)
+        log = (Path(json.loads(out)["run_dir"]) / "mft-record.log").read_text()
+        self.assertIn(f"--output {rec} --overwrite", log)  # mft-record itself is told to replace it
+
+    def test_status_shows_the_pid_of_a_restarted_service(self):
+        env = dict(self.env, FAKE_SERVICES="mft-wbc:crash_after=0.3:crash_times=1")
+        r = subprocess.run(self.sup_cmd("up", self.scenario, "--domain", "23", "--mode", "realtime"), env=env,
+                           capture_output=True, text=True, timeout=60)
+        try:
+            self.assertEqual(r.returncode, 0, r.stderr)
+            deadline = time.time() + 20
+            wbc = []
+            while len(wbc) < 2 and time.time() < deadline:
+                wbc = [int(l.split()[1]) for l in self.pid_log.read_text().splitlines() if l.startswith("mft-wbc ")]
+                time.sleep(0.05)
+            self.assertEqual(len(wbc), 2, "mft-wbc was not restarted within 20 s")
+            deadline = time.time() + 5
+            while time.time() < deadline:  # the state file is rewritten right after the restart
+                st = json.loads(self.plain("status", "--domain", "23", "--json").stdout)
+                if st["services"]["mft-wbc"]["pid"] == wbc[1]:
+                    break
+                time.sleep(0.05)
+            self.assertEqual(st["services"]["mft-wbc"]["pid"], wbc[1])
+            self.assertTrue(st["services"]["mft-wbc"]["alive"])
+            self.assertTrue(all(s["alive"] for s in st["services"].values()), st)
+        finally:
+            self.plain("down", "--domain", "23")
+        self.assertFalse(any(pid_alive(p) for p in self.started_pids()))
+
+    def test_a_run_folder_that_cannot_be_written_is_refused(self):
+        a_file = self.tmp / "a-file"
+        a_file.write_text("x")
+        cases = [(a_file, f"run folder {a_file} exists and is not a directory"),
+                 (a_file / "sub", f"cannot write the run folder {a_file / 'sub'}"),
+                 (Path("/proc/mft-supervisor-test"), "cannot write the run folder /proc/mft-supervisor-test")]
+        for run_dir, expect in cases:
+            code, out, err = self.supervisor("run", str(self.scenario), "--domain", "24", "--run-dir", str(run_dir))
+            self.assertEqual(code, 2, (run_dir, err))
+            self.assert_one_line_error(err, expect)
+        self.assertEqual(self.started_pids(), [])
+
+    def in_private_mounts(self, mounts, argv, env, timeout=60):
+        """Runs argv as root in a mount namespace of its own with `mounts` (shell commands) done first: nothing
+        is mounted on the machine, and the mounts go away with the namespace."""
+        script = "set -e\n" + "\n".join(mounts) + '\nexec "$@"'
+        return subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c", script, "sh"] + argv,
+                              env=env, capture_output=True, text=True, timeout=timeout)
+
+    @unittest.skipUnless(os.geteuid() == 0 and shutil.which("unshare"), "needs root and unshare (mount namespace)")
+    def test_a_read_only_run_folder_is_refused(self):
+        ro = self.tmp / "ro"
+        ro.mkdir()
+        r = self.in_private_mounts([f"mount -t tmpfs -o ro,size=64k tmpfs {ro}"],
+                                   self.sup_cmd("run", self.scenario, "--domain", "25", "--run-dir", ro / "run"),
+                                   dict(self.env, FAKE_SERVICES=""))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assert_one_line_error(r.stderr, f"cannot write the run folder {ro / 'run'}: Read-only file system")
+        self.assertEqual(self.started_pids(), [])
+
+    @unittest.skipUnless(os.geteuid() == 0 and shutil.which("unshare"), "needs root and unshare (mount namespace)")
+    def test_a_full_disk_never_loses_the_result(self):
+        # The run folder on a 64 kB tmpfs, filled up once the services are ready: their logs, their summaries
+        # and summary.json cannot be written, yet the result is printed and every lost file is named.
+        disk = self.tmp / "disk"
+        disk.mkdir()
+        fill = f"(for i in $(seq 400); do grep -q READY {disk}/run/mft-sim.log 2>/dev/null && break; sleep 0.05; done; " \
+               f"cat /dev/zero > {disk}/filler 2>/dev/null) &"
+        r = self.in_private_mounts([f"mount -t tmpfs -o size=64k tmpfs {disk}", fill],
+                                   self.sup_cmd("run", self.scenario, "--domain", "26", "--run-dir", disk / "run",
+                                                "--json"),
+                                   dict(self.env, FAKE_SERVICES="mft-sim:run_for=1.0"))
+        self.assertNotIn("Traceback", r.stderr)
+        s = json.loads(r.stdout)
+        self.assertEqual(s["ticks"], 1000)          # the simulator's summary, read from its output
+        self.assertFalse(s["fell"])
+        self.assertEqual(s["wbc_solve_us"]["p99"], 9.0)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(f"could not write {disk / 'run' / 'summary.json'}: No space left on device", r.stderr)
+        self.assertIn("the summary printed above is complete", r.stderr)
+        self.assertFalse(any(pid_alive(p) for p in self.started_pids()))
+
+    def test_ctrl_c_during_validation_is_one_line(self):
+        env = dict(self.env, FAKE_SERVICES="", FAKE_CHECK_SLOW="10")
+        p = subprocess.Popen(self.sup_cmd("run", self.scenario, "--domain", "27"), env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+        self.procs.append(p)
+        checks = Path(str(self.pid_log) + ".checks")
+        deadline = time.time() + 20
+        while not checks.exists() and time.time() < deadline:
+            time.sleep(0.02)
+        self.assertTrue(checks.exists(), "no --check-config started within 20 s")
+        t0 = time.monotonic()
+        os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole foreground process group
+        out, err = p.communicate(timeout=20)
+        self.assertEqual(p.returncode, 130, err)
+        self.assertNotIn("Traceback", err)
+        self.assertIn("interrupted", err)
+        self.assertLess(time.monotonic() - t0, 2.0)
+        self.assertEqual(self.started_pids(), [])
+
+    def test_ctrl_c_right_at_spawn_stops_promptly(self):
+        env = dict(self.env, FAKE_SERVICES="mft-estimator:ready_after=6,mft-planner:ready_after=6,mft-wbc:ready_after=6")
+        p = subprocess.Popen(self.sup_cmd("run", self.scenario, "--domain", "28"), env=env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True, start_new_session=True)
+        self.procs.append(p)
+        deadline = time.time() + 20
+        while len(self.started_pids()) < 3 and time.time() < deadline:
+            time.sleep(0.02)
+        self.assertEqual(len(self.started_pids()), 3, "the services did not start within 20 s")
+        t0 = time.monotonic()
+        os.killpg(p.pid, signal.SIGINT)  # as a terminal's Ctrl-C
+        out, err = p.communicate(timeout=20)
+        took = time.monotonic() - t0
+        self.assertEqual(p.returncode, 130, err)
+        self.assertIn("interrupted", err)
+        self.assertNotIn("running", err)
+        self.assertNotIn("Traceback", err)
+        self.assertLess(took, 1.5, f"the supervisor took {took:.2f} s to stop after Ctrl-C")
+        self.assertFalse(any(pid_alive(q) for q in self.started_pids()))
+        print(f"\nCtrl-C at spawn: supervisor ended {took:.2f} s after SIGINT", file=sys.stderr)
+
+    def test_a_failed_up_shows_only_its_own_errors(self):
+        runs = self.tmp / "runs"
+        runs.mkdir()
+        (runs / "supervisor-d29.log").write_text("mft-supervisor: error: AN EARLIER STACK'S ERROR\n")
+        code, out, err = self.supervisor("up", str(self.scenario), "--domain", "29",
+                                         fake="mft-planner:fail_start=THIS RUN'S ERROR")
+        self.assertEqual(code, 2, err)
+        self.assertIn("THIS RUN'S ERROR", err)
+        self.assertNotIn("AN EARLIER STACK'S ERROR", err)
+        self.assertNotIn("Traceback", err)
+
+    def test_status_down_and_logs_check_the_domain_first(self):
+        for command in ("status", "down", "logs"):
+            r = subprocess.run([sys.executable, str(SUPERVISOR), command, "--domain", "999"], env=self.env,
+                               capture_output=True, text=True, timeout=30)
+            self.assertEqual(r.returncode, 2, command)
+            self.assert_one_line_error(r.stderr, "bad domain id 999: must be in [0, 232]")
+
+    def test_down_with_nothing_up_is_not_an_error(self):
+        r = subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", "30"], env=self.env,
+                           capture_output=True, text=True, timeout=30)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("no stack is up on domain 30: nothing to stop", r.stdout)
+        r = subprocess.run([sys.executable, str(SUPERVISOR), "down", "--help"], capture_output=True, text=True)
+        self.assertIn("exit 0 when none is up", " ".join(r.stdout.split()))
+
+    def test_a_refused_configuration_starts_nothing(self):
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "31", "--record",
+                                         str(self.tmp / "new.rawlog"),
+                                         FAKE_CHECK_CONFIG=f"mft-wbc={self.cfg}/wbc.yaml: unknown key qp.bogus")
+        self.assertEqual(code, 2, err)
+        self.assert_one_line_error(err, f"configuration refused before anything started: {self.cfg}/wbc.yaml: "
+                                        f"unknown key qp.bogus (mft-wbc)")
+        self.assertEqual(self.started_pids(), [])
+        checked = {l.split()[0] for l in Path(str(self.pid_log) + ".checks").read_text().splitlines()}
+        self.assertEqual(checked, {"mft-sim", "mft-estimator", "mft-planner", "mft-record"})  # every service checked
 
 
 if __name__ == "__main__":

@@ -239,4 +239,13 @@ def main(argv=None):
         REGISTRY.stop_all()
         print("mft-experiment: interrupted; finished runs are kept (run the same command to resume)", file=sys.stderr)
         return 130
+    except UnicodeDecodeError as e:
+        REGISTRY.stop_all()
+        print(f"mft-experiment: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
+        return 2
+    except OSError as e:  # an --out that cannot be written (/proc, a file, read-only, a full disk)
+        REGISTRY.stop_all()
+        where = f": {e.filename}" if e.filename else ""
+        print(f"mft-experiment: error: {e.strerror or e}{where}", file=sys.stderr)
+        return 2
     return 0

@@ -57,7 +57,8 @@ def check_setup(bin_dir, config_dir, need=("mft-sim", "mft-estimator", "mft-plan
         raise ExperimentError(f"configuration folder {config_dir} has no robot.yaml")
 
 
-SNAPSHOT = ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record", "mft-export")
+SNAPSHOT = ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record", "mft-export",
+            "mft-participants")  # the supervisor's domain probe
 
 
 def snapshot_binaries(bin_dir, dest):
@@ -66,7 +67,11 @@ def snapshot_binaries(bin_dir, dest):
     import shutil
     global SUPERVISOR
     dest = Path(dest)
-    if not (dest / "mft-sim").is_file():
+    if (dest / "mft-sim").is_file():  # a snapshot of an earlier version: add what it lacks
+        for name in SNAPSHOT:
+            if not (dest / name).is_file() and (Path(bin_dir) / name).is_file():
+                shutil.copy2(Path(bin_dir) / name, dest / name)
+    else:
         tmp = dest.with_name(dest.name + ".tmp")
         shutil.rmtree(tmp, ignore_errors=True)
         tmp.mkdir(parents=True)
@@ -182,7 +187,7 @@ def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=Non
     argv = [sys.executable, str(SUPERVISOR), "run", str(scenario_path), "--domain", str(domain), "--json",
             "--bin-dir", str(bin_dir), "--config-dir", str(config_dir), "--run-dir", str(run_dir)]
     if record:
-        argv += ["--record", str(record)]
+        argv += ["--record", str(record), "--overwrite"]  # a retried or resumed run replaces its own recording
     env = dict(os.environ, MFT_RUNS_DIR=str(Path(run_dir).parent))
     t0 = time.monotonic()
     p = REGISTRY.popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)

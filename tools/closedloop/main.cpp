@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
   } else {
     std::printf("%s (%s, %s estimator%s%s): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
                 scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",
-                services::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
+                scenario.profiles.empty() ? "" : services::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
                 s.fell ? ": " : "", s.fall_reason.c_str());
     std::printf("  window %.1f s: base z mean %.4f m [%.4f, %.4f], rms error %.4f m; pitch rms %.4f max %.4f rad\n",
                 s.window_s, s.mean_base_z, s.min_base_z, s.max_base_z, s.rms_base_z_error, s.rms_pitch,

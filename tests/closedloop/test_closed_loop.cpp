@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <string>
 
 #include "tools/closedloop/closed_loop.hpp"
@@ -24,6 +25,18 @@ RunSummary runStepping(double height, double speed, double duration, const std::
   const RunSummary s = loop.run();
   std::printf("%s\n", s.toJson().c_str());
   return s;
+}
+
+// The height bias that Table I's contact-force weight puts on the base by design (config/wbc.yaml): the QP
+// minimises w_z (zdd - zdd_des)^2 + w_fc |f_c|^2 with the total normal force F = m (g + zdd) shared by n_st
+// stance feet (|f_c|^2 = F^2 / n_st). Setting the derivative in F to zero: zdd_des - zdd = w_fc m F / (n_st w_z)
+// ~ w_fc m^2 g / (n_st w_z), and the PD of eq. 17 (kp e = that) settles e = w_fc m^2 g / (n_st w_z kp) below the
+// reference. Stepping is single support (n_st = 1, double_support_s 0): 13.0 mm for 23 kg at kp 400; standing
+// n_st = 2: 6.5 mm. The profile contact-weights-small (w_fc 1e-5) makes it 0.1 mm.
+double predictedSag(const Configs& c, int stance_feet) {
+  const double m = c.robot.totalMass();
+  return c.wbc.weights.contact_force * m * m * c.robot.gravity_mps2 /
+         (stance_feet * c.wbc.weights.base_z * c.wbc.gains.base_z.kp);
 }
 
 void expectEstimatorTracksTruth(const RunSummary& s) {
@@ -49,17 +62,42 @@ TEST_P(SteppingInPlace, HoldsItsPlaceWithoutFalling) {
   expectEstimatorTracksTruth(s);
   std::printf("%s at %.2f m: mean base height %.4f m, max MFT violation %.4f rad\n", c.controller, c.height,
               s.mean_base_z, s.max_mft_violation);
-  if (std::abs(c.height - 0.44) < 1e-9) {
-    // MFT-THEORY.md 4.3: the hexagon holds the vertical stance up to 0.435 m; the paper saw about 0.43 m.
-    if (std::string(c.controller) == "mft") {
-      EXPECT_GT(s.mean_base_z, 0.428);
-      EXPECT_LT(s.mean_base_z, 0.436);
-      EXPECT_LT(s.max_mft_violation, 0.01);  // the soft boundary holds within 0.01 rad
-    } else {
-      EXPECT_NEAR(s.mean_base_z, 0.44, 0.004);  // SA-WBC tracks the command (outside the MFT space)
-      EXPECT_GT(s.max_mft_violation, 0.03);
+  // Both variants track the command less the predicted sag (the 4 mm band covers the estimator's 2 mm height
+  // bias, docs/closed-loop.md). Up to 0.44 m the sagged stance lies inside the MFT polytope (the hexagon holds
+  // the vertical stance up to 0.435 m, docs/mft-space.md), so the MFT rows are inactive and MFT-WBC steps like
+  // SA-WBC; at 0.46 m it lies outside.
+  const double expected = c.height - predictedSag(configs(), 1);
+  if (std::string(c.controller) == "sa" || c.height < 0.45) {
+    EXPECT_NEAR(s.mean_base_z, expected, 0.004);
+  }
+  if (c.height - predictedSag(configs(), 1) < 0.435) {
+    EXPECT_LT(s.max_mft_violation, 0.0);
+  }
+  // At 0.46 m the soft MFT rows (w_eps 1e3) pull the stance leg toward the polytope: MFT-WBC steps lower and
+  // violates less than SA-WBC (compared once both have run).
+  static std::map<std::string, RunSummary> at046;
+  if (std::abs(c.height - 0.46) < 1e-9) {
+    at046[c.controller] = s;
+    if (at046.count("mft") && at046.count("sa")) {
+      EXPECT_LT(at046["mft"].mean_base_z, at046["sa"].mean_base_z - 0.001);
+      EXPECT_LT(at046["mft"].max_mft_violation, at046["sa"].max_mft_violation);
     }
   }
+}
+
+// The old departures as profiles (docs/profiles.md): with slack-1e5 and contact-weights-small, MFT-WBC holds the
+// polytope's edge at 0.44 m (the hexagon's vertical stance limit 0.435 m; the paper saw about 0.43 m).
+TEST(SteppingWithProfiles, Slack1e5HoldsThePolytopeEdgeAt044) {
+  const Configs c = loadConfigs(MFT_CONFIG_DIR, {"slack-1e5", "contact-weights-small"});
+  RunOptions o;
+  o.stats_from_s = 5.0;
+  ClosedLoop loop(c, makeScenario(0.44, 0.0, 21.0, "mft", "kalman", 1.0), o);
+  const RunSummary s = loop.run();
+  std::printf("%s\n", s.toJson().c_str());
+  ASSERT_FALSE(s.fell) << s.fall_reason << " at " << s.fall_time_s << " s";
+  EXPECT_GT(s.mean_base_z, 0.428);
+  EXPECT_LT(s.mean_base_z, 0.436);
+  EXPECT_LT(s.max_mft_violation, 0.01);  // the near-hard boundary holds within 0.01 rad
 }
 
 std::string caseName(const ::testing::TestParamInfo<SteppingCase>& info) {

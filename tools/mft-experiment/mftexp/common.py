@@ -181,11 +181,18 @@ def write_report(path, report, png, t0, as_json):
         print(json.dumps(report, indent=1))
 
 
-def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=None, timeout_s=600.0):
+def profile_options(profiles):
+    """--profile NAME for each configuration profile (config/profiles/, docs/profiles.md), in order."""
+    return [a for name in (profiles or []) for a in ("--profile", name)]
+
+
+def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=None, timeout_s=600.0, profiles=()):
     """One lockstep run through the supervisor. Returns (summary dict, wall seconds); raises ExperimentError
-    when the stack itself failed (not when the robot fell) and Interrupted when stopping."""
+    when the stack itself failed (not when the robot fell) and Interrupted when stopping. `profiles` go to
+    the supervisor (--profile), which applies them after the scenario's own."""
     argv = [sys.executable, str(SUPERVISOR), "run", str(scenario_path), "--domain", str(domain), "--json",
             "--bin-dir", str(bin_dir), "--config-dir", str(config_dir), "--run-dir", str(run_dir)]
+    argv += profile_options(profiles)
     if record:
         argv += ["--record", str(record), "--overwrite"]  # a retried or resumed run replaces its own recording
     env = dict(os.environ, MFT_RUNS_DIR=str(Path(run_dir).parent))
@@ -243,9 +250,9 @@ def write_yaml_scenario(path, s):
     Path(path).write_text("\n".join(lines) + "\n")
 
 
-def check_scenario(bin_dir, config_dir, path):
+def check_scenario(bin_dir, config_dir, path, profiles=()):
     p = subprocess.run([str(Path(bin_dir) / "mft-sim"), "--check-scenario", str(path), "--config-dir", str(config_dir),
-                        "--json"], capture_output=True, text=True, timeout=60)
+                        "--json"] + profile_options(profiles), capture_output=True, text=True, timeout=60)
     if p.returncode != 0:
         raise ExperimentError(f"generated scenario {path} is invalid: {(p.stderr or p.stdout).strip()}")
 

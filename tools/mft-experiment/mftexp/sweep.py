@@ -166,12 +166,12 @@ class Sweep:
         scen = rd / "scenario.yaml"
         pushmod.write_scenario(scen, self.setup, h, c, impulse)
         if not self.checked_scenario:
-            check_scenario(self.args.bin_dir, self.args.config_dir, scen)
+            check_scenario(self.args.bin_dir, self.args.config_dir, scen, profiles=self.setup.profiles)
             self.checked_scenario = True
         for attempt in (1, 2, 3):
             try:
                 summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.args.config_dir, record=record,
-                                             timeout_s=self.setup.duration_s * 30 + 120)
+                                             timeout_s=self.setup.duration_s * 30 + 120, profiles=self.setup.profiles)
                 break
             except ExperimentError as e:
                 if attempt == 3 or REGISTRY.stopping.is_set():

@@ -130,7 +130,10 @@ TEST(Standing, HoldsHeightAndPitchFor10s) {
   const RunSummary s = loop.run();
   std::printf("%s\n", s.toJson().c_str());
   ASSERT_FALSE(s.fell) << s.fall_reason << " at " << s.fall_time_s << " s";
-  EXPECT_LT(s.max_abs_base_z_error, 0.005);
+  // Double support: the contact-force weight's predicted sag (predictedSag, n_st = 2: 6.5 mm at Table I's
+  // w_fc), within 1.5 mm; the height error is measured against the reference.
+  EXPECT_NEAR(s.mean_base_z, 0.40 - predictedSag(configs(), 2), 0.0015);
+  EXPECT_LT(s.max_abs_base_z_error, predictedSag(configs(), 2) + 0.002);
   EXPECT_LT(s.max_abs_pitch, 0.01);
   EXPECT_LT(std::abs(s.average_speed), 1e-3);  // no drift
 }

@@ -16,6 +16,8 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
   push-sweep  largest recovered impulse per base height and controller (Table II): table.md/.csv, push_sweep.png
   case        one push with both controllers, the paper's Fig. 6 as a PNG
   terrain     blind walking over the course (board, slope, rough ground) with both controllers, Fig. 8 as a PNG
+  ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
+              and I_max against the slack weight: ablation.md/.csv/.png
 
 Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
 keeps what finished (exit status 130) and stops every stack this tool started."""
@@ -144,7 +146,7 @@ def make_setup(args):
 def build_parser():
     p = Parser(prog="mft-experiment", description=DESCRIPTION,
                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain}", parser_class=Parser)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,ablation}", parser_class=Parser)
     sub.required = True
 
     s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
@@ -186,6 +188,26 @@ def build_parser():
     t.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
     t.add_argument("--out", help="output folder (default runs/terrain-<time>)")
     add_common(t)
+    from . import ablation as _abl
+    a = sub.add_parser("ablation", help="each departure from the paper's setup alone; I_max against the slack weight",
+                       description=_abl.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    a.add_argument("--heights", type=heights_list, default=[0.38, 0.44, 0.46], help="default 0.38,0.44,0.46")
+    a.add_argument("--controllers", type=controllers_list, default=["sa", "mft"], help="default sa,mft")
+    a.add_argument("--toggles", type=lambda t: [x.strip() for x in t.split(",") if x.strip()],
+                   help="only these variants (profile names, rule-no-fall); default: every profile and the rule")
+    a.add_argument("--start", type=positive, default=3.0, help="first impulse [N s] (default 3)")
+    a.add_argument("--step", type=positive, default=0.1, help="fine grid step [N s] (default 0.1)")
+    a.add_argument("--max-impulse", type=positive, default=30.0, help="largest impulse tried [N s] (default 30)")
+    add_search(a, "coarse")
+    a.add_argument("--param", default="wbc.weights.slack",
+                   help="sensitivity: a dotted configuration key FILE.a.b (default wbc.weights.slack)")
+    a.add_argument("--values", type=lambda t: [float(x) for x in t.split(",") if x.strip()],
+                   default=[1e1, 1e2, 1e3, 1e4, 1e5], help="sensitivity values (default 1e1,1e2,1e3,1e4,1e5)")
+    a.add_argument("--sensitivity-height", type=height, default=0.44, help="sensitivity height [m] (default 0.44)")
+    a.add_argument("--no-sensitivity", dest="sensitivity", action="store_false", help="skip the sensitivity")
+    a.add_argument("--out", help="output folder; an existing one is resumed (default runs/ablation-<time>)")
+    add_push_setup(a)
+    add_common(a)
     return p
 
 
@@ -246,7 +268,9 @@ def main(argv=None):
             raise ExperimentError(f"--domain-base {args.domain_base} leaves no DDS domain (0..232) for every stack")
         check_setup(args.bin_dir, args.config_dir,
                     need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
-                         (("mft-record", "mft-export") if args.command != "push-sweep" or args.keep_rawlogs else ()))
+                         (("mft-record", "mft-export") if args.command in ("case", "terrain") or
+                          getattr(args, "keep_rawlogs", False) else ()) +
+                         (("mft-closedloop",) if getattr(args, "inprocess", False) else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
         if args.command in ("case", "terrain"):
@@ -258,6 +282,11 @@ def main(argv=None):
         if args.command == "terrain":
             from .terrain import cmd_terrain
             return cmd_terrain(args)
+        if args.command == "ablation":
+            from .ablation import cmd_ablation
+            args.out = args.out or str(REPO / "runs" / f"ablation-{time.strftime('%Y%m%d-%H%M%S')}")
+            use_snapshot(args)
+            return cmd_ablation(args, make_setup(args))
     except ExperimentError as e:
         REGISTRY.stop_all()
         print(f"mft-experiment: error: {e}", file=sys.stderr)

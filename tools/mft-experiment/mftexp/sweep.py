@@ -231,7 +231,7 @@ class Sweep:
     """Cells (variant, height, controller, direction), each searched for I_max; on the stack (default) or in
     process (mft-closedloop). push-sweep has one variant; ablation and sensitivity have several."""
 
-    def __init__(self, args, setup, variants=None, kind="sweep", config_dir=None):
+    def __init__(self, args, setup, variants=None, kind="sweep", config_dir=None, cells=None):
         self.args = args
         self.setup = setup
         self.kind = kind
@@ -252,7 +252,8 @@ class Sweep:
         self.kmax = int(math.floor((args.max_impulse - args.start) / args.step + 1e-9))
         self.coarse_k = max(1, int(round(self.grid["coarse_Ns"] / args.step)))
         self.above_k = max(0, int(round(self.grid["above_Ns"] / args.step)))
-        self.cells = [(v, h, c, setup.direction) for v in self.variants for h in args.heights for c in args.controllers]
+        self.cells = cells or [(v, h, c, setup.direction) for v in self.variants for h in args.heights
+                               for c in args.controllers]
         self.progress = Progress(args.workers, quiet=args.quiet)
         self.lock = threading.Lock()
         self.cell_runs = {c: 0 for c in self.cells}

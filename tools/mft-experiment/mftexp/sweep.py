@@ -315,7 +315,9 @@ class Sweep:
             try:
                 summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.config_dir, record=record,
                                              timeout_s=setup.duration_s * 30 + 120, profiles=variant.profiles)
-                return summary["services"]["mft-sim"], wall
+                sim = dict(summary["services"]["mft-sim"])
+                sim.setdefault("profiles", summary.get("profiles"))  # what the stack reports it ran with
+                return sim, wall
             except ExperimentError as e:
                 if attempt == 3 or REGISTRY.stopping.is_set():
                     raise
@@ -338,7 +340,7 @@ class Sweep:
                 "pre": rec.get("pre"), "after": rec.get("after"), "tail": rec.get("tail"),
                 "sim_time_s": sim.get("sim_time_s"), "wall_s": round(wall, 3), "domain": domain,
                 "runner": "inprocess" if self.inprocess and not record else "stack",
-                "profiles": self.variants[v].profiles, "run_dir": str(rd), "signature": pushmod.signature(sim),
+                "profiles": self.variants[v].profiles, "applied_profiles": sim.get("profiles"), "run_dir": str(rd), "signature": pushmod.signature(sim),
                 "setup_key": self.setup.key(), "finished_at": time.strftime("%H:%M:%S")}, wall
 
     def recovered(self, cell, k, domain):

@@ -53,7 +53,7 @@ struct SimOptions {
   double hard_stop_damping_Nmsprad = 50.0;
 
   // Actuators.
-  ActuatorModel actuator_model = ActuatorModel::Sea;
+  ActuatorModel actuator_model = ActuatorModel::SeaMotor;  // the physical SEA, as config/sim.yaml
   double speed_limit_band_radps = 2.0;      // drive torque fades to zero over this band below the speed limit
   double damping_mode_gain_Nmsprad = 3.0;   // CommandMode::Damping: tau = -gain * hip rate
   // SeaMotor only (J_r, k_s, w, zeta come from the robot description).

@@ -69,7 +69,7 @@ WbcConfig read(StrictNode& root) {
   c.limits.torque_limit_fraction = l.inRange("torque_limit_fraction", 1e-6, 1.0);
 
   auto& ct = root.child("contact");
-  c.contact.friction_coefficient = ct.positive("friction_coefficient");
+  c.contact.friction_fraction = ct.inRange("friction_fraction", 1e-6, 10.0);
   c.contact.normal_force_max_N = ct.positive("normal_force_max_N");
 
   auto& sa = root.child("sa");

@@ -55,13 +55,15 @@ struct WbcLimits {
 };
 
 struct WbcContact {
-  double friction_coefficient = 0.6;  // pyramid |f_x| <= mu f_z (conservative w.r.t. the real ground)
+  // Pyramid |f_x| <= mu f_z with mu = friction_fraction * robot.yaml contact.friction_coefficient: the QP and
+  // the simulated ground share one coefficient.
+  double friction_fraction = 1.0;
   double normal_force_max_N = 1000.0;  // f_z upper bound of a stance foot (a swing foot gets 0)
 };
 
 struct WbcSaBounds {  // eq. 14 singularity boundaries of the passive knees (with the robot's sign per knee)
-  model::Interval rear_knee_rad{0.1, 3.041592653589793};    // q5, q9 in (0, pi)
-  model::Interval fore_knee_rad{-3.041592653589793, -0.1};  // q7, q11 in (-pi, 0)
+  model::Interval rear_knee_rad{0.0, 3.141592653589793};    // q5, q9: the singularities 0 and pi
+  model::Interval fore_knee_rad{-3.141592653589793, 0.0};   // q7, q11: the singularities -pi and 0
 };
 
 struct WbcSafety {

@@ -86,7 +86,7 @@ WbcParams makeWbcParams(const model::RobotDescription& robot, const WbcConfig& c
   p.weights = config.weights;
   p.gains = config.gains;
   p.tau_max.setConstant(config.limits.torque_limit_fraction * robot.actuator.outputPeakTorque());
-  p.mu = config.contact.friction_coefficient;
+  p.mu = config.contact.friction_fraction * robot.friction_coefficient;  // one coefficient with the ground
   p.fz_max = config.contact.normal_force_max_N;
   p.qdd_base_max = config.limits.qdd_base_max;
   p.qdd_joint_max = config.limits.qdd_joint_max_radps2;

@@ -1,5 +1,7 @@
 #include "model/config/strict_yaml.hpp"
 
+#include "model/config/profiles.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -47,6 +49,13 @@ StrictNode StrictNode::loadFile(const std::string& path) {
     throw ConfigError(path + ": not valid YAML: " + e.what());
   }
   if (!impl->node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
+  // The active profiles (profiles.hpp) change the configuration files they name, for every loader alike.
+  const ProfileSet& profiles = activeProfiles();
+  const std::string stem = profileStemOf(path);
+  if (!stem.empty() && profiles.touches(stem)) {
+    applyProfiles(profiles, stem, &impl->node, path);
+    impl->file = path + " (profiles " + profiles.describe() + ")";
+  }
   return StrictNode(std::move(impl));
 }
 
@@ -188,6 +197,19 @@ std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expe
     }
     if (!std::isfinite(v)) fail(key, "element " + std::to_string(i) + " must be finite");
     out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::string> StrictNode::texts(const std::string& key) {
+  const YAML::Node n = impl_->node[key];
+  if (!n) fail(key, "missing key");
+  if (!n.IsSequence()) fail(key, "expected a list of strings");
+  impl_->used.insert(key);
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (!n[i].IsScalar()) fail(key, "element " + std::to_string(i) + " is not a string");
+    out.push_back(n[i].Scalar());
   }
   return out;
 }

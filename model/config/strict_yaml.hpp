@@ -23,7 +23,8 @@ class ConfigError : public std::runtime_error {
 // never read is reported as unknown. Child mappings are finished automatically by their parent's finish().
 class StrictNode {
  public:
-  // Loads a file; throws ConfigError if it cannot be read or parsed or is not a mapping.
+  // Loads a file; throws ConfigError if it cannot be read or parsed or is not a mapping. A configuration file
+  // that the active profiles change (profiles.hpp) is returned overlaid, named "<path> (profiles a, b)".
   static StrictNode loadFile(const std::string& path);
   // Parses YAML text (for tests and embedded defaults); `origin` names it in messages.
   static StrictNode loadString(const std::string& text, const std::string& origin);
@@ -49,6 +50,7 @@ class StrictNode {
   bool boolean(const std::string& key);
   std::string text(const std::string& key);
   std::vector<double> numbers(const std::string& key, std::size_t expected_size);  // 0 = any size
+  std::vector<std::string> texts(const std::string& key);  // a list of strings
   template <std::size_t N>
   std::array<double, N> fixed(const std::string& key) {
     const auto v = numbers(key, N);

@@ -30,6 +30,7 @@
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
 #include "MftMsgsPubSubTypes.h"
+#include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/polling_udp_transport.hpp"
 #include "services/record/recorder.hpp"
@@ -286,8 +287,9 @@ int main(int argc, char** argv) {
   model::RobotDescription robot;
   services::Scenario scenario;
   try {
-    robot = model::loadRobotDescription(config_file("robot.yaml"));
     scenario = services::loadScenario(cli.get("scenario"));
+    scenario.profiles = services::activateRunProfiles(config_dir, scenario, cli.getAll("profile"));
+    robot = model::loadRobotDescription(config_file("robot.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
@@ -313,8 +315,9 @@ int main(int argc, char** argv) {
   if (opt.first_piece > 0)
     std::printf("mft-record: restarted after a crash: continuing in %s\n", rawlog::pieceName(opt.output, opt.first_piece).c_str());
 
-  // The effective configuration of every service: the files of --config-dir they read, the scenario and
-  // its terrain, verbatim, so a recording can rebuild its controller (mft-replay --through-wbc).
+  // The effective configuration of every service: the files of --config-dir they read (with the profiles in
+  // force applied, so what is stored is what ran), the scenario and its terrain, so a recording can rebuild
+  // its controller (mft-replay --through-wbc). The profiles are named, and their files stored verbatim.
   auto& md = opt.metadata;
   md.created_utc = utcNow();
   md.mode = mode;
@@ -323,10 +326,17 @@ int main(int argc, char** argv) {
   md.scenario_name = scenario.name;
   md.controller = scenario.controller;
   md.robot_checksum = model::checksumHex(robot.checksum);
+  md.profiles = scenario.profiles;
+  const auto& profiles = config::activeProfiles();
   for (const char* f : {"robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml"}) {
     if (!fs::exists(config_file(f))) cli.fail("missing configuration " + config_file(f));
-    md.config[f] = readFile(config_file(f));
+    try {
+      md.config[f] = profiles.applyToText(config::profileStemOf(f), readFile(config_file(f)), config_file(f));
+    } catch (const config::ConfigError& e) {
+      cli.fail(e.what());
+    }
   }
+  for (const auto& name : md.profiles) md.config["profiles/" + name + ".yaml"] = readFile(config_file("profiles/" + name + ".yaml"));
   md.config["scenario"] = readFile(cli.get("scenario"));
   const std::string terrain = "terrain/" + scenario.terrain + ".yaml";
   if (fs::exists(config_file(terrain))) md.config[terrain] = readFile(config_file(terrain));

@@ -542,6 +542,8 @@ std::string metadataYaml(const Metadata& m) {
   e << YAML::Key << "scenario_name" << YAML::Value << m.scenario_name;
   e << YAML::Key << "controller" << YAML::Value << m.controller;
   e << YAML::Key << "robot_checksum" << YAML::Value << m.robot_checksum;
+  e << YAML::Key << "profiles" << YAML::Value << YAML::Flow << m.profiles;
+  e << YAML::Comment("config/profiles/ in force; config below holds the files with them applied");
   e << YAML::Key << "time_base_unix_ns" << YAML::Value << m.time_base_unix_ns;
   e << YAML::Comment("observation timestamp = time_base_unix_ns + stamp_ns of the simulator clock");
   e << YAML::Key << "piece" << YAML::Value << m.piece;
@@ -588,6 +590,7 @@ Metadata parseMetadata(const std::string& text) {
     m.scenario_name = n["scenario_name"].as<std::string>("");
     m.controller = n["controller"].as<std::string>("");
     m.robot_checksum = n["robot_checksum"].as<std::string>("");
+    if (n["profiles"] && n["profiles"].IsSequence()) m.profiles = n["profiles"].as<std::vector<std::string>>();
     m.time_base_unix_ns = n["time_base_unix_ns"].as<std::int64_t>();
     m.piece = n["piece"].as<int>(0);
     if (n["config"] && n["config"].IsMap())

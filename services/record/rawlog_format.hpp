@@ -114,6 +114,7 @@ struct Metadata {
   int domain = -1;
   std::string scenario_file, scenario_name, controller;
   std::string robot_checksum;
+  std::vector<std::string> profiles;  // configuration profiles in force (config/profiles/), in order
   std::int64_t time_base_unix_ns = 0;  // observation timestamp = time_base + stamp_ns
   int piece = 0;
   std::map<std::string, std::string> config;  // file name (robot.yaml, ..., scenario, terrain/<x>.yaml) -> text

@@ -103,6 +103,7 @@ void CommandLine::parse(int argc, char** argv) {
         value = argv[++i];
       }
       values_[name] = value;
+      all_values_[name].push_back(value);
     } else {
       if (inline_value) fail("option --" + name + " takes no value");
       values_[name] = "1";
@@ -116,6 +117,11 @@ std::string CommandLine::get(const std::string& name) const {
   auto v = values_.find(name);
   if (v != values_.end()) return v->second;
   return specs_.at(name).default_value;
+}
+
+std::vector<std::string> CommandLine::getAll(const std::string& name) const {
+  auto v = all_values_.find(name);
+  return v != all_values_.end() ? v->second : std::vector<std::string>{};
 }
 
 bool CommandLine::isSet(const std::string& name) const { return values_.count(name) > 0; }

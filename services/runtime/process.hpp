@@ -30,7 +30,8 @@ class CommandLine {
   void flag(const std::string& name, const std::string& help);
   // Parses argv. On --help prints usage and exits 0; on an error prints it with a hint and exits 2.
   void parse(int argc, char** argv);
-  std::string get(const std::string& name) const;
+  std::string get(const std::string& name) const;  // the last value of an option given more than once
+  std::vector<std::string> getAll(const std::string& name) const;  // every value, in command-line order
   bool isSet(const std::string& name) const;
   long getInt(const std::string& name, long lo, long hi) const;  // exits 2 with a message when out of range
   double getDouble(const std::string& name, double lo, double hi) const;
@@ -46,6 +47,7 @@ class CommandLine {
   std::vector<std::string> order_;
   std::map<std::string, Spec> specs_;
   std::map<std::string, std::string> values_;
+  std::map<std::string, std::vector<std::string>> all_values_;
 };
 
 }  // namespace mft::services

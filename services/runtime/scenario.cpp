@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 
 namespace mft::services {
@@ -86,6 +87,12 @@ Scenario read(StrictNode& root) {
   }
   if (s.commands.front().at_s != 0.0) root.fail("commands", "the first command must be at_s: 0");
 
+  if (root.has("profiles")) {
+    s.profiles = config::splitProfileNames(root.texts("profiles"));
+    for (const auto& name : s.profiles)
+      if (name.find('/') != std::string::npos) root.fail("profiles", "expected names from config/profiles/ (no path)");
+  }
+
   if (root.has("pushes")) {
     const std::size_t n_pushes = root.listSize("pushes");
     for (std::size_t i = 0; i < n_pushes; ++i) {
@@ -114,6 +121,28 @@ Scenario loadScenario(const std::string& path) {
 Scenario parseScenario(const std::string& yaml_text, const std::string& origin) {
   auto root = StrictNode::loadString(yaml_text, origin);
   return read(root);
+}
+
+std::vector<std::string> runProfiles(const Scenario& scenario, const std::vector<std::string>& extra) {
+  std::vector<std::string> names;
+  for (const auto& n : scenario.profiles)
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  for (const auto& n : config::splitProfileNames(extra))
+    if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
+  return names;
+}
+
+std::vector<std::string> activateRunProfiles(const std::string& config_dir, const Scenario& scenario,
+                                             const std::vector<std::string>& extra) {
+  const auto names = runProfiles(scenario, extra);
+  config::setActiveProfiles(config::ProfileSet::load(config_dir, names));
+  return names;
+}
+
+std::string profilesJson(const std::vector<std::string>& names) {
+  std::string o = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) o += (i ? ", \"" : "\"") + names[i] + "\"";
+  return o + "]";
 }
 
 std::string Scenario::toJson() const {
@@ -145,7 +174,7 @@ std::string Scenario::toJson() const {
     o << (i ? ", " : "") << "{\"impulse_Ns\": " << pushes[i].impulse_Ns << ", \"at_s\": " << pushes[i].at_s
       << ", \"at_liftoff\": "
       << (pushes[i].at_liftoff_leg < 0 ? "null" : (pushes[i].at_liftoff_leg == 0 ? "\"right\"" : "\"left\"")) << "}";
-  o << "]}";
+  o << "], \"profiles\": " << profilesJson(profiles) << "}";
   return o.str();
 }
 

@@ -44,12 +44,22 @@ struct Scenario {
   double fall_pitch_rad = 0.0;            // ... or beyond this |pitch|
   // Optional section `recovery:` (every key optional, defaults in push_recovery.hpp): how a push run is judged.
   RecoveryCriteria recovery;
+  std::vector<std::string> profiles;      // config/profiles/ names this scenario runs with (optional key)
 
   std::string toJson() const;
 };
 
 // Loads and validates a scenario file; throws mft::config::ConfigError naming the file and key.
 Scenario loadScenario(const std::string& path);
+
+// The profiles of a run: the scenario's, then `extra` (--profile values, comma lists allowed), each once, in
+// that order. activateRunProfiles also loads them from `config_dir` and installs them for every configuration
+// loader of this process (config::setActiveProfiles); it throws config::ConfigError on a bad profile.
+std::vector<std::string> runProfiles(const Scenario& scenario, const std::vector<std::string>& extra);
+std::vector<std::string> activateRunProfiles(const std::string& config_dir, const Scenario& scenario,
+                                             const std::vector<std::string>& extra);
+// A JSON list of names: ["a", "b"].
+std::string profilesJson(const std::vector<std::string>& names);
 Scenario parseScenario(const std::string& yaml_text, const std::string& origin);
 
 }  // namespace mft::services

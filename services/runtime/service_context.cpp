@@ -15,6 +15,8 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
+  cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "
+             "comma list; docs/profiles.md)");
   cli.option("profiles", "DDS QoS profile file (default: dds_profiles.xml of --config-dir; a multi-host stack gives "
              "each host its own: its address, its peers or discovery server, docs/distributed.md)");
 }
@@ -33,8 +35,9 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   config_dir_ = cli.get("config-dir");
   summary_file_ = cli.get("summary");
   try {
-    robot_ = model::loadRobotDescription(configFile("robot.yaml"));
     scenario_ = loadScenario(cli.get("scenario"));
+    profile_names_ = activateRunProfiles(config_dir_, scenario_, cli.getAll("profile"));
+    robot_ = model::loadRobotDescription(configFile("robot.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }

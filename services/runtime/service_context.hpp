@@ -4,6 +4,7 @@
 // of the chosen loop mode, and the JSON summary written at exit.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "model/robot_description.hpp"
 #include "services/runtime/dds_participant.hpp"
@@ -29,6 +30,8 @@ class ServiceContext {
   bool lockstep() const { return mode_ == LoopMode::Lockstep; }
   const model::RobotDescription& robot() const { return robot_; }
   const Scenario& scenario() const { return scenario_; }
+  // The configuration profiles in force (the scenario's, then --profile), already applied to every loader.
+  const std::vector<std::string>& profileNames() const { return profile_names_; }
   std::string configFile(const std::string& name) const { return config_dir_ + "/" + name; }
   DdsParticipant& participant() { return *participant_; }
 
@@ -47,6 +50,7 @@ class ServiceContext {
   std::string summary_file_;
   model::RobotDescription robot_;
   Scenario scenario_;
+  std::vector<std::string> profile_names_;
   std::unique_ptr<DdsParticipant> participant_;
 };
 

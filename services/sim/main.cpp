@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "MftMsgsPubSubTypes.h"
+#include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/command_watchdog.hpp"
 #include "services/runtime/stall_probe.hpp"
@@ -41,11 +42,15 @@ int checkScenario(int argc, char** argv) {
   services::CommandLine cli("mft-sim --check-scenario", "Validate a scenario file (and its terrain) and exit.");
   cli.option("check-scenario", "the scenario file", "", true);
   cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
-  cli.flag("json", "print the scenario as JSON");
+  cli.option("profile", "configuration profile, after the scenario's (repeatable): checked against every "
+             "configuration file");
+  cli.flag("json", "print the scenario as JSON (its profiles: the scenario's, then --profile)");
   cli.parse(argc, argv);
   try {
+    auto scenario = services::loadScenario(cli.get("check-scenario"));
+    scenario.profiles = services::activateRunProfiles(cli.get("config-dir"), scenario, cli.getAll("profile"));
+    config::activeProfiles().check(cli.get("config-dir"));
     const auto robot = model::loadRobotDescription(cli.get("config-dir") + "/robot.yaml");
-    const auto scenario = services::loadScenario(cli.get("check-scenario"));
     sim::loadTerrain(cli.get("config-dir") + "/terrain/" + scenario.terrain + ".yaml");
     sim::loadSimOptions(cli.get("config-dir") + "/sim.yaml");
     (void)robot;
@@ -516,7 +521,10 @@ int main(int argc, char** argv) {
                   static_cast<unsigned long long>(explained), static_cast<unsigned long long>(misses - explained));
     probe_json = std::string(pj) + per_miss;
   }
-  ctx.writeSummary(std::string(buf) + "\"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json(scenario.recovery, monitor.fell(), monitor.fallTime(), monitor.fallReason()) + ", \"latency_us\": " + latency_us.json() +
+  ctx.writeSummary(std::string(buf) + "\"profiles\": " + services::profilesJson(ctx.profileNames()) +
+                   ", \"damping_episodes\": " + episode_json + ", \"recovery\": " +
+                   recovery.json(scenario.recovery, monitor.fell(), monitor.fallTime(), monitor.fallReason()) +
+                   ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
                    ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
                    std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + probe_json + "}");

@@ -45,7 +45,7 @@ TEST_P(WbcPhysics, SolutionSatisfiesDynamicsClosureFrictionTorqueLimits) {
   WholeBodyController wbc(robot(), cfg, poly);
   const model::PlanarModel m = model::buildBipedModel(robot());
   const double tau_max = robot().actuator.outputPeakTorque();
-  const double mu = cfg.contact.friction_coefficient;
+  const double mu = cfg.contact.friction_fraction * robot().friction_coefficient;
 
   for (const Case& c : cases()) {
     SCOPED_TRACE(c.name);

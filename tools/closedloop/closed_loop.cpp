@@ -1,11 +1,14 @@
 #include "tools/closedloop/closed_loop.hpp"
 
+#include "model/config/profiles.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
 
+#include "model/config/profiles.hpp"
 #include "wbc/reference_from_plan.hpp"
 
 namespace mft::closedloop {
@@ -44,9 +47,11 @@ services::FallCriteria criteriaOf(const services::Scenario& s) {
 
 }  // namespace
 
-Configs loadConfigs(const std::string& dir) {
+Configs loadConfigs(const std::string& dir, const std::vector<std::string>& profiles) {
+  const config::ScopedProfiles scoped(config::ProfileSet::load(dir, profiles));
   Configs c;
   c.config_dir = dir;
+  c.profiles = profiles;
   c.robot = model::loadRobotDescription(dir + "/robot.yaml");
   c.sim = sim::loadSimOptions(dir + "/sim.yaml");
   c.estimator = estimator::loadEstimatorConfig(dir + "/estimator.yaml");

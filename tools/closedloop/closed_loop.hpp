@@ -9,6 +9,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "estimator/state_estimator.hpp"
 #include "model/mft_polytope.hpp"
@@ -28,6 +29,7 @@ namespace mft::closedloop {
 // Every configuration a run needs, loaded from one config folder (the same files the services read).
 struct Configs {
   std::string config_dir;
+  std::vector<std::string> profiles;  // config/profiles/ applied, in order (docs/profiles.md)
   model::RobotDescription robot;
   sim::SimOptions sim;
   estimator::EstimatorConfig estimator;
@@ -35,8 +37,9 @@ struct Configs {
   wbc::WbcConfig wbc;
   model::MftPolytope polytope;
 };
-// Throws config::ConfigError (naming file and key) like the services do at start-up.
-Configs loadConfigs(const std::string& config_dir);
+// Throws config::ConfigError (naming file and key) like the services do at start-up. `profiles` are applied
+// to these loads only (the process's active profiles are restored afterwards).
+Configs loadConfigs(const std::string& config_dir, const std::vector<std::string>& profiles = {});
 
 // A scenario built from a few numbers (no file): stand at `height_m` until `step_at_s`, then step in place
 // (speed 0) or walk (speed != 0) for the rest of `duration_s`. The initial stance width (the scenario's

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
       "(--speed 0) or walk (--speed != 0). With --scenario the given options override the file's values.");
   cli.option("scenario", "scenario file (config/scenarios/*.yaml)");
   cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.option("profile", "configuration profile config/profiles/NAME.yaml, applied after the scenario's "
+             "(repeatable, in order, or a comma list; docs/profiles.md)");
   cli.option("controller", "mft | sa | none (default: the scenario's, else mft)");
   cli.option("estimator", "kalman | ground_truth (default: the scenario's, else kalman)");
   cli.option("height", "base height command and initial height [m] (default 0.42 without a scenario)");
@@ -45,7 +47,6 @@ int main(int argc, char** argv) {
   closedloop::Configs configs;
   services::Scenario scenario;
   try {
-    configs = closedloop::loadConfigs(cli.get("config-dir"));
     if (cli.isSet("scenario")) {
       scenario = services::loadScenario(cli.get("scenario"));
     } else {
@@ -55,6 +56,8 @@ int main(int argc, char** argv) {
       scenario = closedloop::makeScenario(h, v, d, "mft", "kalman", cli.getDouble("step-at", 0.0, 3600.0),
                                           cli.isSet("stand"));
     }
+    scenario.profiles = services::runProfiles(scenario, cli.getAll("profile"));
+    configs = closedloop::loadConfigs(cli.get("config-dir"), scenario.profiles);
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
@@ -116,8 +119,9 @@ int main(int argc, char** argv) {
     std::printf("{\"scenario\": %s, \"summary\": %s, \"recovery\": %s}\n", scenario.toJson().c_str(),
                 s.toJson().c_str(), loop->recoveryJson().c_str());
   } else {
-    std::printf("%s (%s, %s estimator): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
-                scenario.estimator.c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
+    std::printf("%s (%s, %s estimator%s%s): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
+                scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",
+                services::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
                 s.fell ? ": " : "", s.fall_reason.c_str());
     std::printf("  window %.1f s: base z mean %.4f m [%.4f, %.4f], rms error %.4f m; pitch rms %.4f max %.4f rad\n",
                 s.window_s, s.mean_base_z, s.min_base_z, s.max_base_z, s.rms_base_z_error, s.rms_pitch,

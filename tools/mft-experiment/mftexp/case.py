@@ -29,7 +29,7 @@ def run_pair(args, jobs):
                 for attempt in (1, 2, 3):
                     try:
                         results[name] = run_scenario(scen, rd, args.domain_base + i, args.bin_dir, args.config_dir,
-                                                     record=rawlog, timeout_s=timeout)
+                                                     record=rawlog, timeout_s=timeout, profiles=args.profile)
                         break
                     except ExperimentError as e:
                         if attempt == 3 or REGISTRY.stopping.is_set():
@@ -60,7 +60,7 @@ def cmd_case(args, setup):
         rd.mkdir(exist_ok=True)
         scen = rd / "scenario.yaml"
         pushmod.write_scenario(scen, setup, args.height, c, args.impulse)
-        check_scenario(args.bin_dir, args.config_dir, scen)
+        check_scenario(args.bin_dir, args.config_dir, scen, profiles=args.profile)
         jobs.append((c, scen, rd, out / f"{c}.rawlog", setup.duration_s * 40 + 120))
     t0 = time.monotonic()
     runs = run_pair(args, jobs)

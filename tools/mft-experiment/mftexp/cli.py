@@ -80,6 +80,9 @@ def domain_id(text):
 def add_common(p, workers=True):
     p.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
     p.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help="configuration folder (default %(default)s)")
+    p.add_argument("--profile", action="append", default=[], metavar="NAME",
+                   help="configuration profile config/profiles/NAME.yaml (repeatable, applied in order; default: "
+                        "none, the paper's setup; docs/profiles.md); passed to the supervisor")
     p.add_argument("--domain-base", type=domain_id, default=90,
                    help="DDS domain of the first stack; stack i uses domain-base + i (default %(default)s: "
                         "no test uses 90-99; the integration tests take 100-219)")
@@ -138,7 +141,7 @@ def make_setup(args):
     if args.observe < 2.0:
         raise ExperimentError("--observe must be at least 2 s (the recovery window is the last 1 s)")
     return PushSetup(push_after_s=args.push_after, observe_s=args.observe, liftoff=args.liftoff,
-                     direction=args.direction,
+                     direction=args.direction, profiles=list(args.profile),
                      criteria=Criteria(rule=args.recovery_rule, max_speed_mps=args.max_speed, height_band_m=args.height_band,
                                        max_pitch_rad=args.max_pitch, min_touchdowns=args.min_touchdowns))
 

@@ -101,7 +101,7 @@ def cmd_terrain(args):
         rd.mkdir(exist_ok=True)
         scen = rd / "scenario.yaml"
         write_yaml_scenario(scen, scenario(args, c, duration))
-        check_scenario(args.bin_dir, args.config_dir, scen)
+        check_scenario(args.bin_dir, args.config_dir, scen, profiles=args.profile)
         jobs.append((c, scen, rd, out / f"{c}.rawlog", duration * 20 + 120))
     t0 = time.monotonic()
     runs = run_pair(args, jobs)

@@ -3,11 +3,12 @@
 "Push recovery"). For every actuator model, controller and height it runs
 
   mft-closedloop --config-dir <copy with actuators.model = M> --height H --controller C --duration 10
-                 --push I --push-at 5
+                 --push I --push-at 5 --recovery-rule R --json
 
-(exit status 1 = a fall) at every coarse step from --start to --max, and in fine steps between every two
+and takes the loop's own recovery verdict (services/runtime/push_recovery.hpp, the criterion every tool uses;
+--rule stepping = back to stepping in place, the default, or no_fall) at every coarse step from --start to --max, and in fine steps between every two
 neighbouring coarse points that disagree, so a non-monotonic boundary shows. I_max is the largest recovered push
-below the first fall; the largest recovered push and the recovered ranges are reported too. At most --jobs runs
+below the first failure; the largest recovered push and the recovered ranges are reported too. At most --jobs runs
 at a time, under nice. A measurement, not a test.
 
   scripts/push-search.py [--bin build/release/bin/mft-closedloop] [--models sea,sea_motor] [--controllers mft,sa]
@@ -43,11 +44,14 @@ def config_for(model, substeps, tmp):
 
 def recovered(args, cfg, controller, height, push):
     cmd = ["nice", "-n", "5", args.bin, "--config-dir", str(cfg), "--height", f"{height}", "--controller", controller,
-           "--duration", "10", "--push", f"{push:.2f}", "--push-at", "5"]
+           "--duration", "10", "--push", f"{push:.2f}", "--push-at", "5", "--recovery-rule", args.rule, "--json"]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     if p.returncode not in (0, 1):
         raise RuntimeError(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
-    return p.returncode == 0
+    verdict = json.loads(p.stdout)["recovery"]["verdict"]
+    if verdict["outcome"] == "not_pushed":
+        raise RuntimeError(f"{' '.join(cmd)}: the push was never applied")
+    return verdict["recovered"]
 
 
 def search(args, cfg, model, controller, height):
@@ -107,6 +111,8 @@ def main():
     ap.add_argument("--fine", type=float, default=0.1)
     ap.add_argument("--max", type=float, default=16.0)
     ap.add_argument("--substeps", type=int, help="physics steps per control period (default: config/sim.yaml's)")
+    ap.add_argument("--rule", choices=("stepping", "no_fall"), default="stepping",
+                    help="recovered = back to stepping in place (default) or no fall within the run")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", help="write every run to this file")
     args = ap.parse_args()
@@ -115,7 +121,7 @@ def main():
         tasks = [(m, c, float(h)) for m in cfgs for h in args.heights.split(",") for c in args.controllers.split(",")]
         with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
             results = list(pool.map(lambda t: search(args, cfgs[t[0]], *t), tasks))
-    print("| model | height | controller | I_max [N s] | first fall | largest recovered | recovered ranges |")
+    print("| model | height | controller | I_max [N s] | first failure | largest recovered | recovered ranges |")
     print("|---|---|---|---|---|---|---|")
     for r in results:
         print(f"| {r['model']} | {r['height']:.2f} | {r['controller']} | {r['i_max']} | {r['first_fall']} | "

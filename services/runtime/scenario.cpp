@@ -58,6 +58,20 @@ Scenario read(StrictNode& root) {
   auto& fall = root.child("fall");
   s.fall_base_height_m = fall.inRange("base_height_below_m", 0.0, 1.0);
   s.fall_pitch_rad = fall.inRange("pitch_beyond_rad", 0.0, 3.2);
+  if (root.has("recovery")) {
+    auto& r = root.child("recovery");
+    RecoveryCriteria& c = s.recovery;
+    if (r.has("rule") && !parseRecoveryRule(r.text("rule"), &c.rule))
+      r.fail("rule", "unknown rule '" + r.text("rule") + "' (expected stepping or no_fall)");
+    if (r.has("window_s")) c.window_s = r.inRange("window_s", 0.1, 10.0);
+    if (r.has("max_speed_mps")) c.max_speed_mps = r.inRange("max_speed_mps", 0.0, 10.0);
+    if (r.has("height_band_m")) c.height_band_m = r.inRange("height_band_m", 0.0, 1.0);
+    if (r.has("max_pitch_rad")) c.max_pitch_rad = r.inRange("max_pitch_rad", 0.0, 3.2);
+    if (r.has("min_touchdowns")) {
+      c.min_touchdowns = r.integer("min_touchdowns");
+      if (c.min_touchdowns < 0 || c.min_touchdowns > 100) r.fail("min_touchdowns", "expected 0..100");
+    }
+  }
 
   const std::size_t n_commands = root.listSize("commands");
   if (n_commands == 0) root.fail("commands", "at least one command (at_s: 0) is needed");
@@ -151,7 +165,7 @@ std::string Scenario::toJson() const {
     << esc(terrain) << "\", \"initial_base_height_m\": " << initial_base_height_m
     << ", \"initial_stance_width_m\": " << initial_stance_width_m
     << ", \"fall\": {\"base_height_below_m\": " << fall_base_height_m << ", \"pitch_beyond_rad\": " << fall_pitch_rad
-    << "}, \"commands\": [";
+    << "}, \"recovery\": " << recovery.toJson() << ", \"commands\": [";
   for (std::size_t i = 0; i < commands.size(); ++i)
     o << (i ? ", " : "") << "{\"at_s\": " << commands[i].at_s << ", \"mode\": \"" << toString(commands[i].mode)
       << "\", \"z_cmd_m\": " << commands[i].z_cmd_m << ", \"v_cmd_mps\": " << commands[i].v_cmd_mps << "}";

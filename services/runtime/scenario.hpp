@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "services/runtime/push_recovery.hpp"
+
 namespace mft::services {
 
 enum class LocomotionMode { Stand, StepInPlace, Walk };
@@ -40,6 +42,8 @@ struct Scenario {
   std::vector<ScenarioPush> pushes;
   double fall_base_height_m = 0.0;        // the run counts as a fall below this base height
   double fall_pitch_rad = 0.0;            // ... or beyond this |pitch|
+  // Optional section `recovery:` (every key optional, defaults in push_recovery.hpp): how a push run is judged.
+  RecoveryCriteria recovery;
   std::vector<std::string> profiles;      // config/profiles/ names this scenario runs with (optional key)
 
   std::string toJson() const;

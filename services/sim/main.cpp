@@ -25,6 +25,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/input_guard.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/push_recovery.hpp"
 #include "services/runtime/run_monitor.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
@@ -310,7 +311,7 @@ int main(int argc, char** argv) {
   criteria.base_height_below_m = scenario.fall_base_height_m;
   criteria.pitch_beyond_rad = scenario.fall_pitch_rad;
   services::RunMonitor monitor(criteria, 1.0);
-  services::RecoveryWindow recovery(1.0);  // push-recovery judgement (tools/mft-experiment)
+  services::RecoveryWindow recovery(scenario.recovery.window_s, options.control_period_s);  // push-recovery verdict
   std::size_t impulses_seen = 0;
   const bool forever = cli.isSet("forever");
   const auto ticks_total = static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s));
@@ -598,7 +599,9 @@ int main(int argc, char** argv) {
     probe_json = std::string(pj) + per_miss;
   }
   ctx.writeSummary(std::string(buf) + "\"profiles\": " + services::profilesJson(ctx.profileNames()) +
-                   ", \"topic_pushes_applied\": " + pushes_json + ", \"damping_episodes\": " + episode_json + ", \"recovery\": " + recovery.json() + ", \"latency_us\": " + latency_us.json() +
+                   ", \"topic_pushes_applied\": " + pushes_json + ", \"damping_episodes\": " + episode_json + ", \"recovery\": " +
+                   recovery.json(scenario.recovery, monitor.fell(), monitor.fallTime(), monitor.fallReason()) +
+                   ", \"latency_us\": " + latency_us.json() +
                    ", \"watchdog_detection_after_deadline_ms\": " + detection_ms.json() +
                    ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
                    std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + probe_json + "}");

@@ -137,6 +137,54 @@ class ExperimentTest(unittest.TestCase):
         with open(out / "table.csv") as f1, open(self.full / "table.csv") as f2:
             self.assertEqual(f1.read(), f2.read())
 
+    def test_4_ablation_smoke(self):
+        """The ablation on a tiny grid (in process: mft-closedloop): the table's structure, and that toggling a
+        profile changes what the runs were made with (the profile reaches the loop, and the loop says so)."""
+        profiles = sorted(p.stem for p in (REPO / "config" / "profiles").glob("*.yaml"))
+        self.assertTrue(profiles, "no configuration profile in config/profiles")
+        toggle = profiles[0]
+        out = self.tmp / "ablation"
+        t0 = time.monotonic()
+        r = tool("ablation", "--heights", HEIGHT, "--toggles", f"{toggle},rule-no-fall", "--step", "2", "--coarse", "4",
+                 "--max-impulse", "15", "--values", "1e3", "--inprocess", "--bin-dir", BIN, "--out", out, "--json")
+        print(f"ablation smoke: {time.monotonic() - t0:.1f} s", file=sys.stderr)
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+        self.assertIn("left", r.stderr)
+        report = json.loads(r.stdout)
+        self.assertEqual([row["variant"] for row in report["rows"]], ["defaults", toggle, "rule-no-fall"])
+        for row in report["rows"]:
+            cell = row["heights"][HEIGHT]
+            for c in ("sa", "mft"):
+                self.assertIsNotNone(cell[c], row)
+                self.assertGreaterEqual(cell[c], 3.0)
+                self.assertAlmostEqual((cell[c] - 3.0) / 2.0, round((cell[c] - 3.0) / 2.0), places=6)  # on the grid
+            self.assertAlmostEqual(cell["ratio"], cell["mft"] / cell["sa"], places=2)
+        with open(out / "ablation.csv") as f:
+            rows = list(csv.reader(f))
+        self.assertEqual(rows[0], ["variant", "profiles", "rule", f"sa_imax_Ns_{HEIGHT}", f"mft_imax_Ns_{HEIGHT}",
+                                   f"mft_sa_ratio_{HEIGHT}"])
+        self.assertEqual([r_[0] for r_ in rows[1:4]], ["defaults", toggle, "rule-no-fall"])
+        self.assertEqual(rows[2][1], toggle)
+        md = (out / "ablation.md").read_text()
+        self.assertIn(f"| {toggle} |", md)
+        self.assertIn("wbc.weights.slack", md)
+        self.assertTrue((out / "ablation.png").stat().st_size > 1000)
+        sens = report["sensitivity"]["rows"]
+        self.assertEqual(len(sens), 1)
+        self.assertTrue(0.30 < sens[0]["mft_stepping_height_m"] < 0.46, sens)
+        runs = [l for l in lines(out / "results.jsonl") if l["kind"] == "run"]
+        by_variant = {}
+        for l in runs:
+            by_variant.setdefault(l["variant"], []).append(l)
+        self.assertEqual(set(by_variant), {"defaults", toggle, "rule-no-fall", "sens-slack-1e3"})
+        for l in by_variant["defaults"] + by_variant["rule-no-fall"]:
+            self.assertEqual(l["applied_profiles"], [])
+        for l in by_variant[toggle]:
+            self.assertEqual(l["applied_profiles"], [toggle])  # what the loop reports it ran with
+        for l in by_variant["rule-no-fall"]:  # that variant's verdicts follow the other rule
+            self.assertEqual(l["recovered"], l["no_fall"], l)
+        self.assertEqual(processes_mentioning(str(out)), [])
+
     def test_3_clear_errors(self):
         cases = [
             (["push-sweep", "--heights", "0.9"], "outside"),

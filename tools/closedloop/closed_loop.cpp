@@ -89,7 +89,8 @@ ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenari
       options_(options),
       terrain_(sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml")),
       state_builder_(configs.robot),
-      monitor_(criteriaOf(scenario), options.stats_from_s) {
+      monitor_(criteriaOf(scenario), options.stats_from_s),
+      recovery_(scenario.recovery.window_s, configs.sim.control_period_s) {
   sim_ = std::make_unique<sim::Simulator>(configs_.robot, configs_.sim, terrain_);
   sim::StandingPose pose;
   pose.base_height_m = scenario_.initial_base_height_m;
@@ -167,6 +168,12 @@ bool ClosedLoop::step() {
   for (const auto& c : scenario_.commands)
     if (c.at_s <= sim_->time()) z_cmd_ = c.z_cmd_m;
   const bool fell_now = monitor_.update(sim_->groundTruth(), z_cmd_, sim_->stats().body_contact_steps);
+  {  // as mft-sim does it
+    const auto& st = sim_->stats();
+    for (; impulses_seen_ < st.impulses.size(); ++impulses_seen_)
+      recovery_.onImpulse(st.impulses[impulses_seen_].time_s, st.impulses[impulses_seen_].impulse_Ns.x());
+    recovery_.update(sim_->groundTruth(), st.touchdowns[0] + st.touchdowns[1]);
+  }
   accumulate();
   if (fell_now && options_.stop_at_fall) finished_ = true;
   if (sim_->tick() >= ticks_total_) finished_ = true;
@@ -244,6 +251,15 @@ const RunSummary& ClosedLoop::run(const std::function<void(const ClosedLoop&)>& 
     if (each_tick) each_tick(*this);
   if (each_tick && sim_->tick() > 0 && finished_) each_tick(*this);
   return summary_;
+}
+
+services::RecoveryVerdict ClosedLoop::recoveryVerdict() const {
+  return services::judgeRecovery(recovery_.record(), scenario_.recovery, monitor_.fell(), monitor_.fallTime(),
+                                 monitor_.fallReason());
+}
+
+std::string ClosedLoop::recoveryJson() const {
+  return recovery_.json(scenario_.recovery, monitor_.fell(), monitor_.fallTime(), monitor_.fallReason());
 }
 
 std::string RunSummary::toJson() const {

@@ -15,6 +15,7 @@
 #include "model/mft_polytope.hpp"
 #include "model/robot_description.hpp"
 #include "planner/motion_planner.hpp"
+#include "services/runtime/push_recovery.hpp"
 #include "services/runtime/run_monitor.hpp"
 #include "services/runtime/scenario.hpp"
 #include "sim/sim_options.hpp"
@@ -98,6 +99,11 @@ class ClosedLoop {
   const planner::MotionPlanner& planner() const { return *planner_; }
   const wbc::WholeBodyController& controller() const { return *wbc_; }
   const services::RunMonitor& monitor() const { return monitor_; }
+  // The push-recovery record and verdict (services/runtime/push_recovery.hpp) under the scenario's criteria,
+  // exactly as mft-sim reports them in its summary's "recovery" section.
+  const services::RecoveryWindow& recoveryWindow() const { return recovery_; }
+  services::RecoveryVerdict recoveryVerdict() const;
+  std::string recoveryJson() const;
   // This tick's data (valid after the first step()): what the controller saw and did.
   const model::RobotStateEstimate& estimate() const { return estimate_; }
   const model::GroundTruthState& truthAtEstimate() const { return truth_at_estimate_; }
@@ -124,6 +130,8 @@ class ClosedLoop {
   planner::PlannerStateBuilder state_builder_;
   std::unique_ptr<wbc::WholeBodyController> wbc_;
   services::RunMonitor monitor_;
+  services::RecoveryWindow recovery_;
+  std::size_t impulses_seen_ = 0;
   std::vector<std::pair<double, sim::ImpulseSpec>> armed_pushes_;
   std::size_t next_command_ = 0;
   std::uint64_t ticks_total_ = 0;

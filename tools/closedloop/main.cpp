@@ -35,6 +35,8 @@ int main(int argc, char** argv) {
   cli.flag("push-timed", "apply the push at --push-at itself instead of at a lift-off");
   cli.option("stance-width", "initial distance between the feet [m], right foot ahead (default: the scenario's "
              "initial_stance_width_m; without --scenario 0.12 with --stand, else 0)");
+  cli.option("recovery-rule", "what counts as recovered from a push: stepping (back to stepping in place) | "
+             "no_fall (default: the scenario's, else stepping); both outcomes are always in --json's \"recovery\"");
   cli.option("stats-from", "statistics window start [s]", "2.0");
   cli.flag("continue-after-fall", "keep running after a fall");
   cli.option("csv", "write a per-tick trace to this CSV file");
@@ -87,6 +89,9 @@ int main(int argc, char** argv) {
     scenario.pushes.push_back(p);
   }
 
+  if (cli.isSet("recovery-rule") && !services::parseRecoveryRule(cli.get("recovery-rule"), &scenario.recovery.rule))
+    cli.fail("--recovery-rule: expected stepping or no_fall");
+
   closedloop::RunOptions options;
   options.stop_at_fall = !cli.isSet("continue-after-fall");
   options.stats_from_s = cli.getDouble("stats-from", 0.0, 3600.0);
@@ -111,7 +116,8 @@ int main(int argc, char** argv) {
   });
 
   if (cli.isSet("json")) {
-    std::printf("{\"scenario\": %s, \"summary\": %s}\n", scenario.toJson().c_str(), s.toJson().c_str());
+    std::printf("{\"scenario\": %s, \"summary\": %s, \"recovery\": %s}\n", scenario.toJson().c_str(),
+                s.toJson().c_str(), loop->recoveryJson().c_str());
   } else {
     std::printf("%s (%s, %s estimator%s%s): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
                 scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",
@@ -129,6 +135,11 @@ int main(int argc, char** argv) {
                 "%.1fx real time\n",
                 s.max_mft_violation, s.min_lti, static_cast<unsigned long long>(s.non_optimal_solves),
                 static_cast<unsigned long long>(s.torque_clamped_ticks), s.sim_time_s / std::max(s.wall_time_s, 1e-9));
+    if (!scenario.pushes.empty()) {
+      const auto v = loop->recoveryVerdict();
+      std::printf("  push: %s (%s; rule %s)\n", v.recovered ? "RECOVERED" : "NOT RECOVERED", v.reason.c_str(),
+                  services::toString(scenario.recovery.rule));
+    }
   }
   return s.fell ? 1 : 0;
 }

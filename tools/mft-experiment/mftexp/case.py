@@ -72,9 +72,12 @@ def cmd_case(args, setup):
         sim = summary["services"]["mft-sim"]
         recovered, reason = pushmod.judge(sim, setup.criteria)
         csv_dir = out / f"{c}-csv"
-        export_csv(args.bin_dir, out / f"{c}.rawlog", csv_dir, ["gt_q", "gt_qd", "leg_lti"])
+        export_csv(args.bin_dir, out / f"{c}.rawlog", csv_dir,
+                   ["gt_q", "gt_qd", "leg_lti", "plan_ref", "joint_tau_cmd", "joint_tau_meas"])
         traces[c] = {"q": read_csv(csv_dir / "gt_q.csv"), "qd": read_csv(csv_dir / "gt_qd.csv"),
-                     "lti": read_csv(csv_dir / "leg_lti.csv")}
+                     "lti": read_csv(csv_dir / "leg_lti.csv"), "plan": read_csv(csv_dir / "plan_ref.csv"),
+                     "tau_cmd": read_csv(csv_dir / "joint_tau_cmd.csv"),
+                     "tau_meas": read_csv(csv_dir / "joint_tau_meas.csv")}
         rec = sim["recovery"]
         report["controllers"][c] = {
             "recovered": recovered, "reason": reason, "fell": sim.get("fell"), "fall_time_s": sim.get("fall_time_s"),
@@ -83,13 +86,14 @@ def cmd_case(args, setup):
             "after": rec.get("after"), "tail": rec.get("tail"), "rawlog": str(out / f"{c}.rawlog"),
             "wall_s": round(wall, 2)}
     png = plot_case(out / "case.png", args, setup, report, traces)
+    report["fig67"] = str(plot_fig67(out / "case_fig67.png", args, setup, report, traces))
     write_report(out / "case.json", report, png, t0, args.json)
     if not args.json:
         print(f"case: {args.impulse:g} N s {setup.direction} at {args.height:.2f} m ({setup.liftoff}-foot lift-off)")
         for c, r in report["controllers"].items():
             print(f"  {CONTROLLER_NAMES.get(c, c):8s} push at {r['push_time_s']:.3f} s: "
                   f"{'RECOVERED' if r['recovered'] else 'NOT RECOVERED'} ({r['reason']})")
-        print(f"  figure {png}; rawlogs and CSV in {out}")
+        print(f"  figures {png}, {report['fig67']}; rawlogs and CSV in {out}")
     return 0
 
 
@@ -147,6 +151,95 @@ def plot_case(path, args, setup, report, traces):
             ax.grid(alpha=0.3)
     fig.suptitle(f"Push recovery, $z_B^{{ref}}$ = {args.height:.2f} m, I = {args.impulse:g} N s {setup.direction} "
                  f"at a {setup.liftoff}-foot lift-off (dashed: push; x: fall)", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def hip_torque_limit(config_dir):
+    """The hips' output peak torque [N m] from robot.yaml: gear ratio x motor peak torque (x efficiency)."""
+    from .terrain import load_yaml
+    a = (load_yaml(Path(config_dir) / "robot.yaml") or {}).get("actuator") or {}
+    try:
+        return float(a["gear_ratio"]) * float(a["motor_peak_torque_Nm"]) * float(a.get("gearbox_efficiency", 1.0))
+    except (KeyError, TypeError, ValueError):
+        raise ExperimentError(f"{config_dir}/robot.yaml has no actuator gear_ratio / motor_peak_torque_Nm")
+
+
+def stance_leg_traces(tr, rows, b):
+    """Per tick: the planner's stance leg's LTI and its distance outside the polytope's leg hexagon
+    max(A_leg [q_rear, q_fore] - b_leg) [rad] (double support: the worse leg)."""
+    from .terrain import violation
+    q, lti, plan = tr["q"], tr["lti"], tr["plan"]
+    by_tick = {int(t): s for t, s in zip(plan["tick"], plan["stance_leg"])}
+    t_out, l_out, v_out = [], [], []
+    for i, tick in enumerate(q["tick"]):
+        s = by_tick.get(int(tick), -1)
+        vr = violation(rows, b, q["q4"][i], q["q6"][i])
+        vl = violation(rows, b, q["q8"][i], q["q10"][i])
+        lr, ll = lti["lti_right"][i], lti["lti_left"][i]
+        t_out.append(q["time_s"][i])
+        l_out.append(lr if s == 0 else ll if s == 1 else min(lr, ll))
+        v_out.append(vr if s == 0 else vl if s == 1 else max(vr, vl))
+    return t_out, l_out, v_out
+
+
+def plot_fig67(path, args, setup, report, traces):
+    """The paper's Fig. 6/7 quantities for each controller (columns): base height and pitch, the stance leg's
+    LTI with the preferable space's bound (LTI >= 0.7, which the polytope approximates) and its distance outside
+    the polytope, the hip torque commands against the actuators' peak torque."""
+    from .terrain import leg_polygon
+    plt = pyplot()
+    rows, b, _ = leg_polygon(args.config_dir)
+    limit = hip_torque_limit(args.config_dir)
+    cs = args.controllers[:2]
+    fig, axes = plt.subplots(4, len(cs), figsize=(6.2 * len(cs), 10), dpi=110, squeeze=False, sharex=True)
+    tmin = max(0.0, min(r["push_time_s"] for r in report["controllers"].values()) - 1.0)
+    for col, c in enumerate(cs):
+        tr, r = traces[c], report["controllers"][c]
+        name = CONTROLLER_NAMES.get(c, c)
+        state = "recovered" if r["recovered"] else ("FELL" if r["fell"] else "not recovered")
+        ax = axes[0][col]
+        ax.plot(tr["q"]["time_s"], tr["q"]["z"], color=COLORS.get(c), lw=1.2, label="base height")
+        ax.axhline(args.height, color="k", lw=0.6, ls=":", label="reference")
+        ax.set_ylabel("base height [m]")
+        ax.set_title(f"{name}: {args.impulse:g} N s at {args.height:.2f} m, {state}",
+                     color="black" if r["recovered"] else "tab:red", fontsize=10)
+        ax.legend(fontsize=7, loc="lower left")
+        ax = axes[1][col]
+        ax.plot(tr["q"]["time_s"], tr["q"]["pitch"], color=COLORS.get(c), lw=1.2)
+        ax.set_ylabel("pitch [rad]")
+        ax = axes[2][col]
+        t, l, v = stance_leg_traces(tr, rows, b)
+        ax.plot(t, l, color=COLORS.get(c), lw=1.2, label="stance-leg LTI")
+        ax.axhline(0.7, color="k", lw=0.8, ls="--", label="MFT space bound LTI 0.7")
+        ax.set_ylabel("stance-leg LTI")
+        ax.set_ylim(0, 1.02)
+        ax2 = ax.twinx()
+        ax2.plot(t, v, color="tab:green", lw=0.9, alpha=0.8, label="max(A q - b), stance leg")
+        ax2.axhline(0.0, color="tab:green", lw=0.6, ls=":")
+        ax2.set_ylabel("outside the polytope [rad]", color="tab:green")
+        ax.legend(fontsize=7, loc="lower left")
+        ax2.legend(fontsize=7, loc="lower right")
+        ax = axes[3][col]
+        tau = tr["tau_cmd"]
+        for key, label, ls in (("tau_q4", "$\\tau_4$ right rear", "-"), ("tau_q6", "$\\tau_6$ right fore", "--"),
+                               ("tau_q8", "$\\tau_8$ left rear", "-."), ("tau_q10", "$\\tau_{10}$ left fore", ":")):
+            ax.plot(tau["time_s"], tau[key], ls, lw=1.0, label=label)
+        for sgn in (1, -1):
+            ax.axhline(sgn * limit, color="tab:red", lw=0.8, ls="--")
+        ax.text(tmin + 0.05, limit * 0.9, f"peak {limit:.1f} N m", color="tab:red", fontsize=7, va="top")
+        ax.set_ylabel("hip torque command [N m]")
+        ax.set_xlabel("time [s]")
+        ax.legend(fontsize=7, ncol=2, loc="lower left")
+        for ax in axes[:, col]:
+            ax.axvline(r["push_time_s"], color="tab:gray", lw=0.8, ls="--")
+            if r["fell"]:
+                ax.axvline(r["fall_time_s"], color="tab:red", lw=0.8)
+            ax.set_xlim(tmin, setup.duration_s)
+            ax.grid(alpha=0.3)
+    fig.suptitle("Fig. 6/7 equivalents: base, stance-leg MFT, hip torques (dashed grey: push; red: fall)", fontsize=11)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)

@@ -16,6 +16,8 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
   push-sweep  largest recovered impulse per base height and controller (Table II): table.md/.csv, push_sweep.png
   case        one push with both controllers, the paper's Fig. 6 as a PNG
   terrain     blind walking over the course (board, slope, rough ground) with both controllers, Fig. 8 as a PNG
+  ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
+              and I_max against the slack weight: ablation.md/.csv/.png
 
 Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
 keeps what finished (exit status 130) and stops every stack this tool started."""
@@ -103,6 +105,9 @@ def add_push_setup(p):
                    help="the push is armed at this time [s] (stepping starts at 1 s) and applied at the next lift-off")
     g.add_argument("--observe", type=positive, default=5.0,
                    help="run length after --push-after [s]; the last 1 s is the recovery window (default 5)")
+    g.add_argument("--recovery-rule", choices=("stepping", "no_fall"), default="stepping",
+                   help="what counts as recovered: back to stepping in place (default) or no fall within the run; "
+                        "both outcomes are recorded either way")
     g.add_argument("--max-speed", type=positive, default=0.05,
                    help="recovered: |mean base speed| over the last 1 s at most this [m/s] (default 0.05)")
     g.add_argument("--height-band", type=positive, default=0.02,
@@ -111,20 +116,40 @@ def add_push_setup(p):
     g.add_argument("--min-touchdowns", type=int, default=2, help="recovered: touchdowns in the last 1 s (still stepping)")
 
 
+def add_search(p, default):
+    p.add_argument("--search", choices=("linear", "coarse", "bisect"), default=default,
+                   help=f"linear: the paper's scan, exact; coarse: --coarse steps, then the step grid at the first "
+                        f"coarse failure; bisect: quick, not equivalent where recovery is not monotone (default "
+                        f"{default})")
+    p.add_argument("--coarse", type=positive, default=0.5, help="coarse step of --search coarse [N s] (default 0.5)")
+    p.add_argument("--above", type=float, default=1.0,
+                   help="also run this far above the first failure [N s] to report recoveries there (default 1)")
+    p.add_argument("--inprocess", action="store_true",
+                   help="run mft-closedloop (the same libraries, configs and recovery verdict in one process, about "
+                        "8x faster here) instead of the multi-process stack")
+
+
+def load_text():
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "unknown"
+
+
 def make_setup(args):
     from .push import PushSetup, Criteria
     if args.observe < 2.0:
         raise ExperimentError("--observe must be at least 2 s (the recovery window is the last 1 s)")
     return PushSetup(push_after_s=args.push_after, observe_s=args.observe, liftoff=args.liftoff,
                      direction=args.direction, profiles=list(args.profile),
-                     criteria=Criteria(max_speed_mps=args.max_speed, height_band_m=args.height_band,
+                     criteria=Criteria(rule=args.recovery_rule, max_speed_mps=args.max_speed, height_band_m=args.height_band,
                                        max_pitch_rad=args.max_pitch, min_touchdowns=args.min_touchdowns))
 
 
 def build_parser():
     p = Parser(prog="mft-experiment", description=DESCRIPTION,
                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain}", parser_class=Parser)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,ablation}", parser_class=Parser)
     sub.required = True
 
     s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
@@ -136,8 +161,7 @@ def build_parser():
     s.add_argument("--start", type=positive, default=3.0, help="first impulse [N s] (default 3, the paper's)")
     s.add_argument("--step", type=positive, default=0.1, help="impulse grid step [N s] (default 0.1, the paper's)")
     s.add_argument("--max-impulse", type=positive, default=30.0, help="largest impulse tried [N s] (default 30)")
-    s.add_argument("--search", choices=("bisect", "linear"), default="bisect",
-                   help="bisect with a monotonicity check (default) or the paper's linear scan")
+    add_search(s, "linear")
     s.add_argument("--no-rawlogs", dest="keep_rawlogs", action="store_false",
                    help="do not keep the rawlogs of each cell's boundary runs")
     s.add_argument("--out", help="output folder; an existing one is resumed (default runs/experiment-<time>)")
@@ -167,6 +191,26 @@ def build_parser():
     t.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
     t.add_argument("--out", help="output folder (default runs/terrain-<time>)")
     add_common(t)
+    from . import ablation as _abl
+    a = sub.add_parser("ablation", help="each departure from the paper's setup alone; I_max against the slack weight",
+                       description=_abl.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    a.add_argument("--heights", type=heights_list, default=[0.38, 0.44, 0.46], help="default 0.38,0.44,0.46")
+    a.add_argument("--controllers", type=controllers_list, default=["sa", "mft"], help="default sa,mft")
+    a.add_argument("--toggles", type=lambda t: [x.strip() for x in t.split(",") if x.strip()],
+                   help="only these variants (profile names, rule-no-fall); default: every profile and the rule")
+    a.add_argument("--start", type=positive, default=3.0, help="first impulse [N s] (default 3)")
+    a.add_argument("--step", type=positive, default=0.1, help="fine grid step [N s] (default 0.1)")
+    a.add_argument("--max-impulse", type=positive, default=30.0, help="largest impulse tried [N s] (default 30)")
+    add_search(a, "coarse")
+    a.add_argument("--param", default="wbc.weights.slack",
+                   help="sensitivity: a dotted configuration key FILE.a.b (default wbc.weights.slack)")
+    a.add_argument("--values", type=lambda t: [float(x) for x in t.split(",") if x.strip()],
+                   default=[1e1, 1e2, 1e3, 1e4, 1e5], help="sensitivity values (default 1e1,1e2,1e3,1e4,1e5)")
+    a.add_argument("--sensitivity-height", type=height, default=0.44, help="sensitivity height [m] (default 0.44)")
+    a.add_argument("--no-sensitivity", dest="sensitivity", action="store_false", help="skip the sensitivity")
+    a.add_argument("--out", help="output folder; an existing one is resumed (default runs/ablation-<time>)")
+    add_push_setup(a)
+    add_common(a)
     return p
 
 
@@ -187,19 +231,24 @@ def cmd_push_sweep(args):
     setup = make_setup(args)
     args.out = args.out or str(REPO / "runs" / f"experiment-{time.strftime('%Y%m%d-%H%M%S')}")
     use_snapshot(args)
+    if args.inprocess:
+        args.keep_rawlogs = False
     sweep = Sweep(args, setup)
+    load0 = load_text()
     log(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
-        f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), {args.workers} stacks on "
-        f"domains {args.domain_base}..{args.domain_base + args.workers - 1}")
+        f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), "
+        + ("in process" if args.inprocess else f"{args.workers} stacks on domains {args.domain_base}.."
+                                                f"{args.domain_base + args.workers - 1}") + f"; load average {load0}")
     wall = None
     try:
         wall = sweep.run()
     finally:
         table = report.write_tables(args.out, sweep.results, args.heights, args.controllers, args.direction,
-                                    sweep.grid, asdict(setup), wall)
+                                    sweep.grid, dict(asdict(setup), profiles=sweep.variants["default"].profiles),
+                                    wall, (load0, load_text()))
     png = report.plot_sweep(args.out, table, args.direction)
     summary = report.summary_json(table, sweep.results, sweep.grid, asdict(setup), wall, sweep.new_runs)
-    summary.update({"out": args.out, "table_md": str(Path(args.out) / "table.md"),
+    summary.update({"load_average": [load0, load_text()], "out": args.out, "table_md": str(Path(args.out) / "table.md"),
                     "table_csv": str(Path(args.out) / "table.csv"), "plot": str(png)})
     (Path(args.out) / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     log(f"done in {fmt_duration(wall)} ({sweep.new_runs} new runs): {args.out}/table.md, table.csv, push_sweep.png")
@@ -222,7 +271,9 @@ def main(argv=None):
             raise ExperimentError(f"--domain-base {args.domain_base} leaves no DDS domain (0..232) for every stack")
         check_setup(args.bin_dir, args.config_dir,
                     need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
-                         (("mft-record", "mft-export") if args.command != "push-sweep" or args.keep_rawlogs else ()))
+                         (("mft-record", "mft-export") if args.command in ("case", "terrain") or
+                          getattr(args, "keep_rawlogs", False) else ()) +
+                         (("mft-closedloop",) if getattr(args, "inprocess", False) else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
         if args.command in ("case", "terrain"):
@@ -234,6 +285,11 @@ def main(argv=None):
         if args.command == "terrain":
             from .terrain import cmd_terrain
             return cmd_terrain(args)
+        if args.command == "ablation":
+            from .ablation import cmd_ablation
+            args.out = args.out or str(REPO / "runs" / f"ablation-{time.strftime('%Y%m%d-%H%M%S')}")
+            use_snapshot(args)
+            return cmd_ablation(args, make_setup(args))
     except ExperimentError as e:
         REGISTRY.stop_all()
         print(f"mft-experiment: error: {e}", file=sys.stderr)

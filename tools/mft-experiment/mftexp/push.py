@@ -3,10 +3,12 @@
 A run: stand 1 s, step in place from 1 s at the reference height, a sagittal impulse on the torso at the first
 lift-off of the chosen foot after `push_after_s`, then `observe_s` more seconds. Fall = the stack's own
 criteria (mft-sim, services/runtime/run_monitor.hpp): base below 0.25 m, |pitch| > 0.8 rad, a thigh, shank or
-the torso touching the ground, or a leg at a singular configuration (LTI < 0.02). Recovered = no fall until
-the end AND back to stepping in place over the last `window` second (mft-sim's recovery.tail):
-|mean base speed| <= max_speed, |mean base height - mean base height over the second before the push| <=
-height_band, |pitch| <= max_pitch, at least min_touchdowns touchdowns (still stepping)."""
+the torso touching the ground, or a leg at a singular configuration (LTI < 0.02). Recovered: the verdict of the
+project's one criterion (services/runtime/push_recovery.hpp), computed by mft-sim (or mft-closedloop) with the
+criteria written into the scenario's recovery: section. Rule "stepping" (default): no fall until the end AND back
+to stepping in place over the last `window` second: |mean base speed| <= max_speed, |mean base height - mean base
+height over the second before the push| <= height_band, |pitch| <= max_pitch, at least min_touchdowns touchdowns.
+Rule "no_fall": no fall until the end. Both outcomes are always recorded."""
 import hashlib
 import json
 from dataclasses import dataclass, asdict, field
@@ -16,6 +18,7 @@ from .common import write_yaml_scenario
 
 @dataclass
 class Criteria:
+    rule: str = "stepping"       # stepping | no_fall: which outcome counts as recovered
     max_speed_mps: float = 0.05
     height_band_m: float = 0.02
     max_pitch_rad: float = 0.1
@@ -52,6 +55,9 @@ def scenario(setup, height, controller, impulse):
         "duration_s": setup.duration_s, "controller": controller, "estimator": setup.estimator, "terrain": "flat",
         "initial_base_height_m": float(height),
         "fall": {"base_height_below_m": setup.fall_base_height_m, "pitch_beyond_rad": setup.fall_pitch_rad},
+        "recovery": {"rule": setup.criteria.rule, "window_s": 1.0, "max_speed_mps": setup.criteria.max_speed_mps,
+                     "height_band_m": setup.criteria.height_band_m, "max_pitch_rad": setup.criteria.max_pitch_rad,
+                     "min_touchdowns": setup.criteria.min_touchdowns},
         "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": float(height), "v_cmd_mps": 0.0},
                      {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": float(height), "v_cmd_mps": 0.0}],
         "pushes": [{"impulse_Ns": round(sign * impulse, 6), "at_s": setup.push_after_s, "at_liftoff": setup.liftoff}],
@@ -62,27 +68,15 @@ def write_scenario(path, setup, height, controller, impulse):
     write_yaml_scenario(path, scenario(setup, height, controller, impulse))
 
 
-def judge(sim, criteria):
-    """(recovered, reason) from mft-sim's summary."""
-    rec = sim["recovery"]
-    if sim.get("fell"):
-        return False, f"fell at {sim.get('fall_time_s', 0):.3f} s: {sim.get('fall_reason')}"
-    if rec.get("push_time_s") is None or rec.get("impulses", 0) < 1:
+def judge(sim, criteria=None):
+    """(recovered, reason) from the verdict in mft-sim's (or mft-closedloop's) summary; recovered is None when
+    the push was never applied. The rule is the one written into the scenario (criteria is not re-applied)."""
+    v = (sim.get("recovery") or {}).get("verdict")
+    if v is None:
+        raise KeyError("the summary has no recovery verdict (rebuild mft-sim / mft-closedloop)")
+    if v["outcome"] == "not_pushed":
         return None, "the push was never applied (no lift-off after the arming time)"
-    tail, pre = rec["tail"], rec["pre"]
-    why = []
-    if abs(tail["mean_speed_mps"]) > criteria.max_speed_mps:
-        why.append(f"|mean speed| {abs(tail['mean_speed_mps']):.3f} > {criteria.max_speed_mps} m/s")
-    dz = tail["mean_base_height_m"] - pre["mean_base_height_m"]
-    if abs(dz) > criteria.height_band_m:
-        why.append(f"base height {dz * 1000:+.1f} mm from before the push (band {criteria.height_band_m * 1000:.0f} mm)")
-    if tail["max_abs_pitch_rad"] > criteria.max_pitch_rad:
-        why.append(f"|pitch| {tail['max_abs_pitch_rad']:.3f} > {criteria.max_pitch_rad} rad")
-    if tail["touchdowns"] < criteria.min_touchdowns:
-        why.append(f"{tail['touchdowns']} touchdowns in the last {rec['window_s']} s (not stepping)")
-    if why:
-        return False, "no fall but not recovered: " + "; ".join(why)
-    return True, "recovered"
+    return bool(v["recovered"]), v["reason"]
 
 
 def signature(sim):

@@ -24,24 +24,36 @@ def increase_pct(sa, mft):
     return round(100.0 * (mft["i_max_Ns"] - sa["i_max_Ns"]) / sa["i_max_Ns"], 1)
 
 
-def rows(results, heights, direction):
+def ratio(sa, mft):
+    """I_max(MFT-WBC) / I_max(SA-WBC), None unless both cells found their boundary."""
+    inc = increase_pct(sa, mft)
+    return None if inc is None else round(mft["i_max_Ns"] / sa["i_max_Ns"], 3)
+
+
+def rows(results, heights, direction, variant="default"):
     out = []
     for h in heights:
-        sa = results.cells.get((h, "sa", direction))
-        mft = results.cells.get((h, "mft", direction))
+        sa = results.cells.get((variant, h, "sa", direction))
+        mft = results.cells.get((variant, h, "mft", direction))
         out.append((h, sa, mft, increase_pct(sa, mft)))
     return out
 
 
-def write_tables(out_dir, results, heights, controllers, direction, grid, setup, wall_s=None):
+def above_text(cell):
+    a = (cell or {}).get("recovered_above_Ns") or []
+    return ", ".join(f"{x:g}" for x in a)
+
+
+def write_tables(out_dir, results, heights, controllers, direction, grid, setup, wall_s=None, load=None):
     out_dir = Path(out_dir)
     start, mx = grid["start_Ns"], grid["max_Ns"]
     table = rows(results, heights, direction)
     # CSV: one row per height (the machine-readable form of Table II)
     with open(out_dir / "table.csv", "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["height_m", "sa_imax_Ns", "mft_imax_Ns", "increase_pct", "sa_status", "mft_status",
-                    "sa_bracket_Ns", "mft_bracket_Ns", "paper_sa_imax_Ns", "paper_mft_imax_Ns", "paper_increase_pct"])
+        w.writerow(["height_m", "sa_imax_Ns", "mft_imax_Ns", "mft_sa_ratio", "increase_pct", "sa_status", "mft_status",
+                    "sa_bracket_Ns", "mft_bracket_Ns", "sa_recovered_above_Ns", "mft_recovered_above_Ns",
+                    "paper_sa_imax_Ns", "paper_mft_imax_Ns", "paper_mft_sa_ratio", "paper_increase_pct"])
         for h, sa, mft, inc in table:
             p = PAPER_TABLE2.get(round(h, 2), {})
             br = lambda c: "" if c is None else f"{c['recovered_Ns'] if c['recovered_Ns'] is not None else ''}/" \
@@ -49,9 +61,11 @@ def write_tables(out_dir, results, heights, controllers, direction, grid, setup,
             w.writerow([f"{h:.2f}",
                         "" if sa is None or sa["i_max_Ns"] is None else f"{sa['i_max_Ns']:.2f}",
                         "" if mft is None or mft["i_max_Ns"] is None else f"{mft['i_max_Ns']:.2f}",
-                        "" if inc is None else f"{inc:.1f}",
+                        "" if inc is None else f"{ratio(sa, mft):.3f}", "" if inc is None else f"{inc:.1f}",
                         "" if sa is None else sa["status"], "" if mft is None else mft["status"], br(sa), br(mft),
-                        p.get("sa", ""), p.get("mft", ""), p.get("increase_pct", "")])
+                        above_text(sa).replace(", ", " "), above_text(mft).replace(", ", " "),
+                        p.get("sa", ""), p.get("mft", ""), f"{p['mft'] / p['sa']:.3f}" if p else "",
+                        p.get("increase_pct", "")])
     # Markdown in the paper's layout: heights across, SA, MFT, increase down; then the paper's rows
     hs = " | ".join(f"{h:.2f}" for h, *_ in table)
     lines = [f"Results of push-recovery tests ({direction} push at a {setup['liftoff']}-foot lift-off, "
@@ -59,25 +73,33 @@ def write_tables(out_dir, results, heights, controllers, direction, grid, setup,
              f"| z_B^ref [m] | {hs} |", "|---" * (len(table) + 1) + "|",
              "| I_max of SA-WBC [N s] | " + " | ".join(imax_text(sa, start, mx) for _, sa, _, _ in table) + " |",
              "| I_max of MFT-WBC [N s] | " + " | ".join(imax_text(m, start, mx) for _, _, m, _ in table) + " |",
+             "| MFT/SA ratio | " + " | ".join("–" if i is None else f"{ratio(sa, m):.2f}" for _, sa, m, i in table) + " |",
              "| Percentage of increase [%] | " + " | ".join("–" if i is None else f"{i:+.1f}" for *_, i in table) + " |",
              "| paper: I_max of SA-WBC [N s] | " + " | ".join(str(PAPER_TABLE2.get(round(h, 2), {}).get("sa", "–"))
                                                           for h, *_ in table) + " |",
              "| paper: I_max of MFT-WBC [N s] | " + " | ".join(str(PAPER_TABLE2.get(round(h, 2), {}).get("mft", "–"))
                                                            for h, *_ in table) + " |",
+             "| paper: MFT/SA ratio | " + " | ".join(
+                 (lambda p: f"{p['mft'] / p['sa']:.2f}" if p else "–")(PAPER_TABLE2.get(round(h, 2)))
+                 for h, *_ in table) + " |",
              "| paper: percentage of increase [%] | " + " | ".join(
                  str(PAPER_TABLE2.get(round(h, 2), {}).get("increase_pct", "–")) for h, *_ in table) + " |", ""]
-    lines.append("Boundary of each cell (last recovered / first failed impulse [N s], monotonicity check, runs):")
+    lines.append("Boundary of each cell (I_max / first failure [N s], recoveries above the first failure, runs, "
+                 "the first failure's reason):")
     lines.append("")
     for h, sa, mft, _ in table:
         for name, c in (("SA-WBC", sa), ("MFT-WBC", mft)):
             if c is None:
                 continue
-            first_fail = next((r for r in [results.runs.get((h, c["controller"], direction, f"{c['failed_Ns']:.3f}"))]
-                               if c["failed_Ns"] is not None and r), None)
-            lines.append(f"- {h:.2f} m {name}: {c['recovered_Ns']} / {c['failed_Ns']}, monotone {c['monotone']}, "
-                         f"{c['runs']} runs" + (f"; first failure: {first_fail['reason']}" if first_fail else ""))
+            ff = c.get("first_failure") or {}
+            lines.append(f"- {h:.2f} m {name}: {c['recovered_Ns']} / {c['failed_Ns']}, "
+                         f"recovered above: {above_text(c) or 'none seen'}, {c['runs']} runs"
+                         + (f"; first failure ({ff.get('outcome')}): {ff.get('reason')}" if ff else ""))
+    lines += ["", f"Setup: profiles {', '.join(setup.get('profiles') or []) or 'none (the defaults)'}, recovery rule "
+                  f"{setup['criteria']['rule']}, runner {grid.get('runner', 'stack')}."]
     if wall_s is not None:
-        lines += ["", f"Wall time of this invocation: {wall_s / 60:.1f} min."]
+        lines += ["", f"Wall time of this invocation: {wall_s / 60:.1f} min" +
+                  (f" (load average before / after: {load[0]} / {load[1]})." if load else ".")]
     (out_dir / "table.md").write_text("\n".join(lines) + "\n")
     return table
 
@@ -117,6 +139,11 @@ def summary_json(table, results, grid, setup, wall_s, new_runs):
     return {"grid": grid, "setup": setup, "wall_s": None if wall_s is None else round(wall_s, 1),
             "new_runs": new_runs, "runs_on_file": len(results.runs),
             "table": [{"height_m": h,
-                       "sa": None if sa is None else {k: sa[k] for k in ("i_max_Ns", "status", "recovered_Ns", "failed_Ns", "monotone", "runs", "deterministic", "rawlogs")},
-                       "mft": None if m is None else {k: m[k] for k in ("i_max_Ns", "status", "recovered_Ns", "failed_Ns", "monotone", "runs", "deterministic", "rawlogs")},
-                       "increase_pct": inc, "paper": PAPER_TABLE2.get(round(h, 2))} for h, sa, m, inc in table]}
+                       "sa": None if sa is None else {k: sa.get(k) for k in CELL_KEYS},
+                       "mft": None if m is None else {k: m.get(k) for k in CELL_KEYS},
+                       "mft_sa_ratio": ratio(sa, m), "increase_pct": inc, "paper": PAPER_TABLE2.get(round(h, 2))}
+                      for h, sa, m, inc in table]}
+
+
+CELL_KEYS = ("i_max_Ns", "status", "recovered_Ns", "failed_Ns", "first_failure", "recovered_above_Ns",
+             "largest_recovered_Ns", "monotone", "runs", "deterministic", "rawlogs")

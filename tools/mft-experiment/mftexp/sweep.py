@@ -1,38 +1,40 @@
 """push-sweep: the largest impulse each controller recovers from at each base height (the paper's Table II).
 
-Search per cell (height, controller) on the grid I_k = start + k * step (the paper: 3 N s, 0.1 N s):
-  bisect (default): run I_0; if it fails, I_max < start (checked: I_1, I_2 fail too). Otherwise bracket upward
-  from I_0 in increments of 2, 4, 8 ... N s (capped at --max-impulse), then bisect to adjacent grid points
-  lo (recovered) and hi = lo + 1 (failed). Monotonicity check around the boundary: I_lo-1, I_lo-2 must recover
-  and I_hi+1, I_hi+2 must fail. If not, the cell falls back to the paper's linear rule in a window of 1 N s
-  either side (from the window's start upward, I_max = the last recovered impulse before the first failure; from
-  I_0 if the window's first point fails already) and reports the outcomes it saw ("non_monotone").
-  linear: the paper's procedure literally: I_0, I_1, ... until the first failure.
+I_max follows the paper: on the grid I_k = start + k * step (3 N s, 0.1 N s), the largest impulse before the
+first failure. "Failure" is the project's one recovery criterion (--recovery-rule, default: back to stepping in
+place; services/runtime/push_recovery.hpp). Search per cell (height, controller):
+  linear (default): the paper's procedure literally: I_0, I_1, ... until the first failure; exact by definition.
+    Then --above N s more on the same grid, to report recoveries above the first failure where they exist.
+  coarse: a linear scan on the coarse grid (--coarse, 0.5 N s) until its first failure, then the fine grid
+    between the last coarse recovery and that failure, linear again. It equals "linear" unless a failure hides
+    between two recovered coarse points (not run); cheaper by about coarse/step. --above as for linear.
+  bisect: bracket and bisect to a recovered/failed pair one step apart, check two steps either side, and fall
+    back to a linear scan over 1 N s below the boundary when they disagree. Not equivalent to the paper's rule
+    where recovery is not monotone further below; kept for quick looks.
 Every finished run is one JSON line in results.jsonl (fsync'ed), so an interrupted sweep resumes without
-re-running anything; lockstep runs are deterministic, so a cached outcome is the outcome. At the end of a cell
-the boundary runs are re-run with --record (kept rawlogs) and must give identical summaries."""
+re-running anything; lockstep runs are deterministic, so a cached outcome is the outcome. With --rawlogs the two
+runs at each cell's boundary are re-run with --record (kept rawlogs) and must give identical summaries."""
+import hashlib
 import json
 import math
 import os
 import threading
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .common import (ExperimentError, Interrupted, Progress, REGISTRY, check_scenario, log, run_scenario, run_workers,
-                     fmt_duration)
+from .common import (ExperimentError, Interrupted, Progress, REGISTRY, check_scenario, log, run_closedloop,
+                     run_scenario, run_workers)
 from . import push as pushmod
-
-CELL_ORDER_NOTE = "cells run on --workers stacks in parallel, each on its own DDS domain"
 
 
 def config_hash(config_dir):
-    """What the runs depend on besides the scenario: every configuration file the services read."""
-    import hashlib
+    """What the runs depend on besides the scenario: every configuration file the services read, and profiles."""
     h = hashlib.sha1()
     root = Path(config_dir)
-    for name in ("robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml",
-                 "terrain/flat.yaml"):
+    names = ["robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml",
+             "terrain/flat.yaml"] + sorted(str(p.relative_to(root)) for p in root.glob("profiles/*.yaml"))
+    for name in names:
         p = root / name
         h.update(name.encode() + b"\0" + (p.read_bytes() if p.is_file() else b"missing") + b"\0")
     return h.hexdigest()[:12]
@@ -42,20 +44,35 @@ def ikey(i):
     return f"{i:.3f}"
 
 
-def cell_name(h, c, direction):
-    return f"h{h:.2f}-{c}-{direction}"
+@dataclass
+class Variant:
+    """One setup of an experiment: the configuration profiles on top of the defaults, and the recovery rule."""
+    name: str = "default"
+    profiles: list = field(default_factory=list)
+    rule: str = "stepping"
+    label: str = "the defaults (the paper's setup)"
+
+
+def cell_name(cell):
+    v, h, c, direction = cell
+    return (f"{v}-" if v != "default" else "") + f"h{h:.2f}-{c}-{direction}"
 
 
 class ResultsFile:
-    def __init__(self, path, header):
+    def __init__(self, path, header, kind="sweep"):
         self.path = Path(path)
+        self.kind = kind
         self.lock = threading.Lock()
-        self.runs, self.cells, self.records = {}, {}, {}
+        self.runs, self.cells, self.records, self.extra = {}, {}, {}, {}
         self.resumed = self.path.exists()
         if self.path.exists():
             self._load(header)
         else:
             self._append(header)
+
+    @staticmethod
+    def cell_of(d):
+        return (d.get("variant", "default"), d.get("height"), d.get("controller"), d.get("direction"))
 
     def _load(self, header):
         lines = self.path.read_text().splitlines()
@@ -71,10 +88,12 @@ class ResultsFile:
                     continue
                 raise ExperimentError(f"{self.path}:{n}: not a JSON line; is this a results file of mft-experiment?")
             good.append(d)
-        if not good or good[0].get("kind") != "sweep":
-            raise ExperimentError(f"{self.path}: not a push-sweep results file (no 'sweep' header line)")
+        if not good or good[0].get("kind") != self.kind:
+            raise ExperimentError(f"{self.path}: not a {self.kind} results file of mft-experiment (no '{self.kind}' "
+                                  f"header line)")
         old = good[0]
-        if old.get("setup_key") != header["setup_key"] or old.get("grid") != header["grid"]:
+        if old.get("setup_key") != header["setup_key"] or old.get("grid") != header["grid"] or \
+                old.get("variants") != header.get("variants"):
             raise ExperimentError(
                 f"{self.path} was made with other settings (setup {old.get('setup')}, grid {old.get('grid')}); "
                 f"resume it with the same options or choose another --out")
@@ -83,13 +102,15 @@ class ResultsFile:
                 f"{self.path} was made with other settings: the configuration ({old.get('config_dir')}) has changed "
                 f"since; its runs would not be comparable: choose another --out")
         for d in good[1:]:
-            k = (d.get("height"), d.get("controller"), d.get("direction"))
+            k = self.cell_of(d)
             if d.get("kind") == "run":
                 self.runs[k + (ikey(d["impulse_Ns"]),)] = d
             elif d.get("kind") == "cell":
                 self.cells[k] = d
             elif d.get("kind") == "record":
                 self.records[k + (d["label"],)] = d
+            elif d.get("kind"):
+                self.extra.setdefault(d["kind"], {})[d.get("key")] = d
         # rewrite without a cut last line, so appends start on a fresh line
         self.path.write_text("".join(json.dumps(d) + "\n" for d in good))
 
@@ -103,93 +124,224 @@ class ResultsFile:
     def add_run(self, d):
         self._append(d)
         with self.lock:
-            self.runs[(d["height"], d["controller"], d["direction"], ikey(d["impulse_Ns"]))] = d
+            self.runs[self.cell_of(d) + (ikey(d["impulse_Ns"]),)] = d
 
     def add_cell(self, d):
         self._append(d)
         with self.lock:
-            self.cells[(d["height"], d["controller"], d["direction"])] = d
+            self.cells[self.cell_of(d)] = d
 
     def add_record(self, d):
         self._append(d)
         with self.lock:
-            self.records[(d["height"], d["controller"], d["direction"], d["label"])] = d
+            self.records[self.cell_of(d) + (d["label"],)] = d
+
+    def add_extra(self, d):
+        self._append(d)
+        with self.lock:
+            self.extra.setdefault(d["kind"], {})[d.get("key")] = d
+
+
+def find_imax(rec, kmax, search, coarse_k=5, above_k=10):
+    """The paper's I_max on the grid k = 0..kmax, with rec(k) -> recovered. Returns (lo, first_fail, info):
+    lo = the last k before the first failure (None: the first point failed), first_fail = the first failed k
+    (None: none up to kmax), info = how it was found and the recoveries above the first failure."""
+    info = {"monotone": None, "checks": [], "non_monotone_scan": None}
+    if search in ("linear", "coarse"):
+        step = 1 if search == "linear" else max(1, coarse_k)
+        k, last_ok, fail = 0, None, None
+        while k <= kmax:
+            if rec(k):
+                last_ok = k
+                k += step
+            else:
+                fail = k
+                break
+        if step > 1 and fail is not None:  # the fine grid between the last coarse recovery and the coarse failure
+            a = 0 if last_ok is None else last_ok + 1
+            for j in range(a, fail):
+                if not rec(j):
+                    fail = j
+                    break
+        elif step > 1 and fail is None and last_ok is not None and last_ok < kmax:
+            for j in range(last_ok + 1, kmax + 1):
+                if not rec(j):
+                    fail = j
+                    break
+        info["monotone"] = f"not assumed ({search} scan)"
+        lo = None if fail == 0 else (kmax if fail is None else fail - 1)
+        if fail is not None:  # what lies above the first failure, on the same grid
+            info["above"] = [(j, rec(j)) for j in range(fail + 1, min(kmax, fail + above_k) + 1, step)]
+        return lo, fail, info
+    # bisect
+    lo = hi = None
+    if not rec(0):
+        lo, hi = None, 0
+    else:
+        lo, inc = 0, 2 * coarse_k
+        while True:
+            k = min(lo + inc, kmax)
+            if k == lo:
+                break
+            if rec(k):
+                lo = k
+                inc *= 2
+            else:
+                hi = k
+                break
+        if hi is not None:
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if rec(mid):
+                    lo = mid
+                else:
+                    hi = mid
+    checks = []
+    if lo is not None:
+        checks += [(k, True) for k in (lo - 1, lo - 2) if k >= 0]
+    if hi is not None:
+        checks += [(k, False) for k in (hi + 1, hi + 2) if k <= kmax]
+    ok = True
+    for k, want in checks:
+        got = rec(k)
+        info["checks"].append({"k": k, "expected": want, "recovered": got})
+        ok = ok and got == want
+    info["monotone"] = ok
+    if not ok:
+        w = 2 * coarse_k
+        a = max(0, (lo if lo is not None else 0) - w)
+        if a > 0 and not rec(a):
+            a = 0  # the window starts in a failure: the paper's scan from I_0
+        scan, first_fail = [], None
+        for k in range(a, kmax + 1):
+            r = rec(k)
+            scan.append({"k": k, "recovered": r})
+            if not r:
+                first_fail = k
+                break
+        info["non_monotone_scan"] = scan
+        hi = first_fail
+        lo = kmax if first_fail is None else (first_fail - 1 if first_fail > 0 else None)
+    if hi is not None:
+        info["above"] = [(k, rec(k)) for k in (hi + 1, hi + 2) if k <= kmax]
+    return lo, hi, info
 
 
 class Sweep:
-    def __init__(self, args, setup):
+    """Cells (variant, height, controller, direction), each searched for I_max; on the stack (default) or in
+    process (mft-closedloop). push-sweep has one variant; ablation and sensitivity have several."""
+
+    def __init__(self, args, setup, variants=None, kind="sweep", config_dir=None, cells=None):
         self.args = args
         self.setup = setup
+        self.kind = kind
+        self.config_dir = str(config_dir or args.config_dir)
+        self.variants = {v.name: v for v in (variants or [Variant(profiles=list(getattr(args, "profile", []) or []),
+                                                                   rule=setup.criteria.rule)])}
         self.out = Path(args.out)
         self.out.mkdir(parents=True, exist_ok=True)
-        self.grid = {"start_Ns": args.start, "step_Ns": args.step, "max_Ns": args.max_impulse, "search": args.search}
-        header = {"kind": "sweep", "version": 1, "setup_key": setup.key(), "setup": asdict(setup), "grid": self.grid,
-                  "config_hash": config_hash(args.config_dir), "config_dir": str(args.config_dir),
+        self.inprocess = bool(getattr(args, "inprocess", False))
+        self.grid = {"start_Ns": args.start, "step_Ns": args.step, "max_Ns": args.max_impulse, "search": args.search,
+                     "coarse_Ns": getattr(args, "coarse", 0.5), "above_Ns": getattr(args, "above", 1.0),
+                     "runner": "inprocess" if self.inprocess else "stack"}
+        header = {"kind": kind, "version": 2, "setup_key": setup.key(), "setup": asdict(setup), "grid": self.grid,
+                  "variants": {n: asdict(v) for n, v in self.variants.items()},
+                  "config_hash": config_hash(self.config_dir), "config_dir": self.config_dir,
                   "created": time.strftime("%Y-%m-%d %H:%M:%S")}
-        self.results = ResultsFile(self.out / "results.jsonl", header)
+        self.results = ResultsFile(self.out / "results.jsonl", header, kind)
         self.kmax = int(math.floor((args.max_impulse - args.start) / args.step + 1e-9))
-        self.cells = [(h, c, setup.direction) for h in args.heights for c in args.controllers]
+        self.coarse_k = max(1, int(round(self.grid["coarse_Ns"] / args.step)))
+        self.above_k = max(0, int(round(self.grid["above_Ns"] / args.step)))
+        self.cells = cells or [(v, h, c, setup.direction) for v in self.variants for h in args.heights
+                               for c in args.controllers]
         self.progress = Progress(args.workers, quiet=args.quiet)
         self.lock = threading.Lock()
-        self.cell_runs = {c: 0 for c in self.cells}  # runs done (cost units) per cell, this session and before
+        self.cell_runs = {c: 0 for c in self.cells}
         for k in self.results.runs:
-            if k[:3] in self.cell_runs:
-                self.cell_runs[k[:3]] += 1
+            if k[:4] in self.cell_runs:
+                self.cell_runs[k[:4]] += 1
         self.new_runs = 0
-        self.checked_scenario = False
+        self.checked = set()
+        self.extra_remaining = 0  # runs outside the cells (e.g. stepping heights), for the time left
 
     # ------------------------------------------------------------------------------------------ estimates
     def expected_cost(self):
         done = [c for c in self.cells if c in self.results.cells]
         if done:
-            return sum(self.cell_runs[c] + 2 * (2 if self.args.keep_rawlogs else 0) for c in done) / len(done)
+            return sum(self.cell_runs[c] for c in done) / len(done)
+        guess_k = (10.0 - self.args.start) / self.args.step  # a boundary near 10 N s
         if self.args.search == "linear":
-            return (8.0 - self.args.start) / self.args.step + 1 + (4 if self.args.keep_rawlogs else 0)
-        return 1 + 4 + math.ceil(math.log2(max(2.0, 8.0 / self.args.step))) + 4 + (4 if self.args.keep_rawlogs else 0)
+            return guess_k + self.above_k
+        if self.args.search == "coarse":
+            return guess_k / self.coarse_k + self.coarse_k + self.above_k / self.coarse_k
+        return 12 + (4 if self.args.keep_rawlogs else 0)
 
     def remaining_runs(self):
         e = self.expected_cost()
         with self.lock:
-            return sum(max(1.0, e - self.cell_runs[c]) for c in self.cells if c not in self.results.cells)
+            return sum(max(1.0, e - self.cell_runs[c]) for c in self.cells if c not in self.results.cells) + \
+                self.extra_remaining
 
     # ------------------------------------------------------------------------------------------------ runs
     def impulse(self, k):
         return round(self.args.start + k * self.args.step, 6)
 
     def run_dir(self, cell, impulse, suffix=""):
-        return self.out / "runs" / cell_name(*cell) / f"{ikey(impulse)}{suffix}"
+        return self.out / "runs" / cell_name(cell) / f"{ikey(impulse)}{suffix}"
 
-    def run_one(self, cell, impulse, domain, record=None):
-        h, c, direction = cell
-        rd = self.run_dir(cell, impulse, "-rec" if record else "")
+    def setup_for(self, variant):
+        s = pushmod.PushSetup(**{k: getattr(self.setup, k) for k in self.setup.__dataclass_fields__})
+        s.criteria = pushmod.Criteria(**dict(asdict(self.setup.criteria), rule=variant.rule))
+        s.profiles = list(variant.profiles)
+        return s
+
+    def run_push(self, variant, height, controller, impulse, rd, domain, record=None):
+        """One run (impulse None: stepping only, no push). Returns (mft-sim-like summary, wall)."""
         rd.mkdir(parents=True, exist_ok=True)
         scen = rd / "scenario.yaml"
-        pushmod.write_scenario(scen, self.setup, h, c, impulse)
-        if not self.checked_scenario:
-            check_scenario(self.args.bin_dir, self.args.config_dir, scen, profiles=self.setup.profiles)
-            self.checked_scenario = True
+        setup = self.setup_for(variant)
+        s = pushmod.scenario(setup, height, controller, impulse or 0.0)
+        if impulse is None:
+            s.pop("pushes")
+        from .common import write_yaml_scenario
+        write_yaml_scenario(scen, s)
+        if variant.name not in self.checked:
+            check_scenario(self.args.bin_dir, self.config_dir, scen, profiles=variant.profiles)
+            self.checked.add(variant.name)
+        if self.inprocess and not record:
+            return run_closedloop(scen, self.args.bin_dir, self.config_dir, timeout_s=setup.duration_s * 60 + 60,
+                                  profiles=variant.profiles)
         for attempt in (1, 2, 3):
             try:
-                summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.args.config_dir, record=record,
-                                             timeout_s=self.setup.duration_s * 30 + 120, profiles=self.setup.profiles)
-                break
+                summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.config_dir, record=record,
+                                             timeout_s=setup.duration_s * 30 + 120, profiles=variant.profiles)
+                sim = dict(summary["services"]["mft-sim"])
+                sim.setdefault("profiles", summary.get("profiles"))  # what the stack reports it ran with
+                return sim, wall
             except ExperimentError as e:
                 if attempt == 3 or REGISTRY.stopping.is_set():
                     raise
                 log(f"{e}; retrying ({attempt} of 2)")
                 time.sleep(3.0 * attempt)
-        sim = summary["services"]["mft-sim"]
-        recovered, reason = pushmod.judge(sim, self.setup.criteria)
+
+    def run_one(self, cell, impulse, domain, record=None):
+        v, h, c, direction = cell
+        rd = self.run_dir(cell, impulse, "-rec" if record else "")
+        sim, wall = self.run_push(self.variants[v], h, c, impulse, rd, domain, record)
+        recovered, reason = pushmod.judge(sim)
         if recovered is None:
-            raise ExperimentError(f"{cell_name(*cell)} I={impulse}: {reason} (logs in {rd})")
+            raise ExperimentError(f"{cell_name(cell)} I={impulse}: {reason} (logs in {rd})")
         rec = sim["recovery"]
-        return {"height": h, "controller": c, "direction": direction, "impulse_Ns": impulse, "recovered": recovered,
-                "reason": reason, "fell": sim.get("fell"), "fall_reason": sim.get("fall_reason"),
+        return {"variant": v, "height": h, "controller": c, "direction": direction, "impulse_Ns": impulse,
+                "recovered": recovered, "reason": reason, "outcome": rec["verdict"]["outcome"],
+                "no_fall": rec["verdict"]["no_fall"], "back_to_stepping": rec["verdict"]["back_to_stepping"],
+                "fell": sim.get("fell"), "fall_reason": sim.get("fall_reason"),
                 "fall_time_s": sim.get("fall_time_s"), "push_time_s": rec.get("push_time_s"),
                 "pre": rec.get("pre"), "after": rec.get("after"), "tail": rec.get("tail"),
                 "sim_time_s": sim.get("sim_time_s"), "wall_s": round(wall, 3), "domain": domain,
-                "run_dir": str(rd), "signature": pushmod.signature(sim), "setup_key": self.setup.key(),
-                "finished_at": time.strftime("%H:%M:%S")}, wall
+                "runner": "inprocess" if self.inprocess and not record else "stack",
+                "profiles": self.variants[v].profiles, "applied_profiles": sim.get("profiles"), "run_dir": str(rd), "signature": pushmod.signature(sim),
+                "setup_key": self.setup.key(), "finished_at": time.strftime("%H:%M:%S")}, wall
 
     def recovered(self, cell, k, domain):
         imp = self.impulse(k)
@@ -203,109 +355,64 @@ class Sweep:
                 self.cell_runs[cell] += 1
                 self.new_runs += 1
             self.progress.run_finished(
-                wall, f"{cell_name(*cell)} I = {imp:.2f} N s: {'recovered' if d['recovered'] else d['reason']} "
-                      f"({wall:.1f} s, domain {domain})", self.remaining_runs())
+                wall, f"{cell_name(cell)} I = {imp:.2f} N s: {'recovered' if d['recovered'] else d['reason']} "
+                      f"({wall:.1f} s{'' if self.inprocess else f', domain {domain}'})", self.remaining_runs())
         return d["recovered"]
 
     # ---------------------------------------------------------------------------------------------- search
     def search_cell(self, cell, domain):
         t0 = time.monotonic()
-        rec = lambda k: self.recovered(cell, k, domain)
-        kmax = self.kmax
-        info = {"monotone": None, "checks": [], "non_monotone_scan": None}
-        lo = hi = None
-        if self.args.search == "linear":
-            k = 0
-            while k <= kmax and rec(k):
-                k += 1
-            lo, hi = (k - 1 if k > 0 else None), (k if k <= kmax else None)
-            info["monotone"] = "not checked (linear scan)"
-        elif not rec(0):
-            lo, hi = None, 0
-        else:
-            lo, inc = 0, max(1, int(round(2.0 / self.args.step)))
-            while True:
-                k = min(lo + inc, kmax)
-                if k == lo:
-                    break
-                if rec(k):
-                    lo = k
-                    inc *= 2
-                else:
-                    hi = k
-                    break
-            if hi is not None:
-                while hi - lo > 1:
-                    mid = (lo + hi) // 2
-                    if rec(mid):
-                        lo = mid
-                    else:
-                        hi = mid
-        if self.args.search == "bisect":
-            checks = []
-            if lo is not None:
-                checks += [(k, True) for k in (lo - 1, lo - 2) if k >= 0]
-            if hi is not None:
-                checks += [(k, False) for k in (hi + 1, hi + 2) if k <= kmax]
-            ok = True
-            for k, want in checks:
-                got = rec(k)
-                info["checks"].append({"impulse_Ns": self.impulse(k), "expected": want, "recovered": got})
-                ok = ok and got == want
-            info["monotone"] = ok
-            if not ok:
-                w = max(1, int(round(1.0 / self.args.step)))
-                a = max(0, (lo if lo is not None else 0) - w)
-                if a > 0 and not rec(a):
-                    a = 0  # the window starts in a failure: the paper's scan from I_0
-                scan = []
-                first_fail = None
-                for k in range(a, kmax + 1):  # the paper's rule: up to the first failure
-                    r = rec(k)
-                    scan.append({"impulse_Ns": self.impulse(k), "recovered": r})
-                    if not r and first_fail is None:
-                        first_fail = k
-                        break
-                info["non_monotone_scan"] = scan
-                hi = first_fail
-                lo = kmax if first_fail is None else (first_fail - 1 if first_fail > 0 else None)
-                log(f"{cell_name(*cell)}: recovery is not monotone around the boundary; linear rule in the window "
-                    f"gives I_max = {self.impulse(lo) if lo is not None else '< start'}")
+        lo, hi, info = find_imax(lambda k: self.recovered(cell, k, domain), self.kmax, self.args.search,
+                                 self.coarse_k, self.above_k)
+        above = [self.impulse(k) for k, ok in info.pop("above", []) if ok]
+        for key in ("checks", "non_monotone_scan"):
+            for d in info.get(key) or []:
+                d["impulse_Ns"] = self.impulse(d.pop("k"))
+        # every run of this cell on file: the recoveries above the first failure, the largest recovery
+        runs = {float(k[4]): d for k, d in self.results.runs.items() if k[:4] == cell}
+        if hi is not None:
+            above = sorted({i for i, d in runs.items() if d["recovered"] and i > self.impulse(hi) + 1e-9} | set(above))
+        first = runs.get(self.impulse(hi)) if hi is not None else None
         status = "ok" if lo is not None and hi is not None else ("below_start" if lo is None else "at_max")
-        cell_rec = {"kind": "cell", "height": cell[0], "controller": cell[1], "direction": cell[2],
-                    "setup_key": self.setup.key(), "status": status,
+        cell_rec = {"kind": "cell", "variant": cell[0], "height": cell[1], "controller": cell[2], "direction": cell[3],
+                    "setup_key": self.setup.key(), "status": status, "search": self.args.search,
                     "i_max_Ns": self.impulse(lo) if lo is not None else None,
                     "recovered_Ns": self.impulse(lo) if lo is not None else None,
                     "failed_Ns": self.impulse(hi) if hi is not None else None,
+                    "first_failure": None if first is None else {"outcome": first.get("outcome"),
+                                                                 "reason": first["reason"]},
+                    "recovered_above_Ns": above,
+                    "largest_recovered_Ns": max([i for i, d in runs.items() if d["recovered"]], default=None),
                     "runs": self.cell_runs[cell], **info}
-        # kept rawlogs: the boundary runs again with --record; lockstep: the same outcome, bit for bit
         rawlogs, deterministic = {}, True
-        if self.args.keep_rawlogs:
+        if getattr(self.args, "keep_rawlogs", False):
             for label, k in (("recovered", lo), ("failed", hi)):
                 if k is None:
                     continue
                 imp = self.impulse(k)
                 prev = self.results.records.get(cell + (label,))
-                path = self.out / "rawlogs" / cell_name(*cell) / f"{label}-{imp:.2f}Ns.rawlog"
+                path = self.out / "rawlogs" / cell_name(cell) / f"{label}-{imp:.2f}Ns.rawlog"
                 if prev and Path(prev["rawlog"]).exists() and prev["impulse_Ns"] == imp:
                     rawlogs[label] = prev["rawlog"]
                     deterministic = deterministic and prev["identical"]
                     continue
                 path.parent.mkdir(parents=True, exist_ok=True)
                 d, wall = self.run_one(cell, imp, domain, record=path)
-                first = self.results.runs[cell + (ikey(imp),)]
-                same = d["signature"] == first["signature"]
+                first_run = self.results.runs[cell + (ikey(imp),)]
+                same = d["signature"] == first_run["signature"] or first_run.get("runner") == "inprocess" and \
+                    d["recovered"] == first_run["recovered"]
                 deterministic = deterministic and same
-                self.results.add_record({"kind": "record", "height": cell[0], "controller": cell[1],
-                                         "direction": cell[2], "label": label, "impulse_Ns": imp, "rawlog": str(path),
-                                         "recovered": d["recovered"], "identical": same, "wall_s": round(wall, 3)})
+                self.results.add_record({"kind": "record", "variant": cell[0], "height": cell[1],
+                                         "controller": cell[2], "direction": cell[3], "label": label,
+                                         "impulse_Ns": imp, "rawlog": str(path), "recovered": d["recovered"],
+                                         "identical": same, "wall_s": round(wall, 3)})
                 with self.lock:
-                    self.cell_runs[cell] += 2
-                self.progress.run_finished(wall, f"{cell_name(*cell)} I = {imp:.2f} N s recorded to {path.name}: "
+                    self.cell_runs[cell] += 1
+                self.progress.run_finished(wall, f"{cell_name(cell)} I = {imp:.2f} N s recorded to {path.name}: "
                                                  f"{'identical' if same else 'DIFFERENT'} outcome", self.remaining_runs())
                 rawlogs[label] = str(path)
                 if not same:
-                    log(f"{cell_name(*cell)} I = {imp:.2f}: the recorded run differs from the first run "
+                    log(f"{cell_name(cell)} I = {imp:.2f}: the recorded run differs from the first run "
                         f"(lockstep should be deterministic)")
         cell_rec["rawlogs"] = rawlogs
         cell_rec["deterministic"] = deterministic if rawlogs else None
@@ -314,16 +421,21 @@ class Sweep:
         shown = {"ok": f"I_max = {cell_rec['i_max_Ns']:.2f} N s" if lo is not None else "",
                  "below_start": f"I_max < {self.args.start} N s",
                  "at_max": f"I_max >= {self.args.max_impulse} N s (no failure found)"}[status]
-        self.progress.note(f"cell {cell_name(*cell)} done: {shown}, monotone {info['monotone']}")
+        if above:
+            shown += f", recovered above the first failure at {', '.join(f'{a:g}' for a in above)}"
+        self.progress.note(f"cell {cell_name(cell)} done: {shown}")
         return cell_rec
 
     # ------------------------------------------------------------------------------------------------- all
-    def run(self):
+    def run(self, extra_jobs=()):
+        """Searches every cell not on file; `extra_jobs` are callables job(domain) run by the same workers."""
         todo = [c for c in self.cells if c not in self.results.cells]
         if self.results.resumed:
             log(f"resuming {self.out / 'results.jsonl'}: {len(self.cells) - len(todo)} of {len(self.cells)} cells "
                 f"done, {len(self.results.runs)} runs on file")
-        queue = list(todo)
+        # the longest cells first (SA-WBC's boundary lies higher), so the last worker is not left alone at the end
+        queue = [("extra", j) for j in extra_jobs] + [("cell", c) for c in todo]
+        self.extra_remaining = len(extra_jobs)
         qlock = threading.Lock()
         errors = []
 
@@ -333,9 +445,14 @@ class Sweep:
                 with qlock:
                     if not queue:
                         return
-                    cell = queue.pop(0)
+                    kind, item = queue.pop(0)
                 try:
-                    self.search_cell(cell, domain)
+                    if kind == "cell":
+                        self.search_cell(item, domain)
+                    else:
+                        item(domain)
+                        with self.lock:
+                            self.extra_remaining -= 1
                 except Interrupted:
                     return
                 except BaseException as e:  # noqa: the main thread reports it

@@ -122,7 +122,7 @@ def cmd_terrain(args):
         traces[c] = tr
         q = tr["gt_q"]
         max_x = max(q["x"]) if q["x"] else 0.0
-        traversed = (not sim.get("fell")) and max_x >= course_end
+        traversed = sim["recovery"]["verdict"]["no_fall"] and max_x >= course_end  # the one criterion's no-fall outcome
         # left leg in stance on the up-slope: the planner's stance flag (what the WBC treats as stance)
         stance = dict(zip(tr["plan_ref"]["tick"], tr["plan_ref"]["in_stance_left"]))
         viol = []

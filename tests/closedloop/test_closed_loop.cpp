@@ -50,7 +50,7 @@ TEST_P(SteppingInPlace, HoldsItsPlaceWithoutFalling) {
   std::printf("%s at %.2f m: mean base height %.4f m, max MFT violation %.4f rad\n", c.controller, c.height,
               s.mean_base_z, s.max_mft_violation);
   if (std::abs(c.height - 0.44) < 1e-9) {
-    // MFT-THEORY.md 4.3: the hexagon holds the vertical stance up to 0.435 m; the paper saw about 0.43 m.
+    // docs/five-bar-theory.md#vertical-stance-numbers: the hexagon holds the vertical stance up to 0.435 m; the paper saw about 0.43 m.
     if (std::string(c.controller) == "mft") {
       EXPECT_GT(s.mean_base_z, 0.428);
       EXPECT_LT(s.mean_base_z, 0.436);

@@ -74,7 +74,7 @@ std::vector<QpInstance> loadFolder(const std::string& dir) {
   return out;
 }
 
-// Real-time hygiene as in QP.md section 1; every step degrades gracefully and is reported.
+// Real-time hygiene as in docs/qp.md#measuring-solve-time; every step degrades gracefully and is reported.
 std::string prepareProcess(int cpu) {
   std::string notes;
   mallopt(M_MMAP_MAX, 0);

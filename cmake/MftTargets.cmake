@@ -1,9 +1,13 @@
-# Per-target settings shared by every mft-wbc target. Warnings are set per target, never globally.
+# Per-target settings shared by every mft-wbc target. Warnings are set per target, never globally, so code we
+# do not write (fastddsgen's generated mft_msgs) gets neither the warnings nor MFT_WERROR.
 function(mft_target_settings target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                            -Woverloaded-virtual -Wcast-align -Wformat=2)
+    if(MFT_WERROR)
+      target_compile_options(${target} PRIVATE -Werror)
+    endif()
   endif()
 endfunction()
 
@@ -37,7 +41,7 @@ function(mft_add_gtest name)
   mft_target_settings(${name})
   target_link_libraries(${name} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_definitions(${name} PRIVATE MFT_CONFIG_DIR="${MFT_CONFIG_DIR}"
-                             MFT_SHARED_DIR="${MFT_SHARED_DIR}" MFT_BIN_DIR="${PROJECT_BINARY_DIR}/bin"
+                             MFT_BIN_DIR="${PROJECT_BINARY_DIR}/bin"
                              MFT_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data")
   if(NOT A_TIMEOUT)
     set(A_TIMEOUT 300)

@@ -18,7 +18,7 @@ usage() {
   echo
   echo "Options:"
   echo "  --profile data   governance with data-only ENCRYPT on every topic, discovery and liveliness encrypted,"
-  echo "                   RTPS messages and submessage metadata not protected (the cheaper option, DDS.md 7; default)"
+  echo "                   RTPS messages and submessage metadata not protected (the cheaper option, docs/dds.md#security; default)"
   echo "  --profile full   everything ENCRYPT (rtps, metadata, data, discovery, liveliness)"
   echo "  --days N         validity of the certificates and permissions (default 365)"
   echo "  --cn-prefix T    prefix of every certificate's common name (default empty; a second CA made with the"
@@ -65,7 +65,7 @@ cd "$DIR"
 
 IDENTITIES=(sim estimator planner wbc record cmd)
 ALL_TOPICS=(SensorData GroundTruth RobotState OperatorCommand Reference JointCommand WbcDiagnostics Disturbance)
-# Who may publish / subscribe what (ARCHITECTURE.md section 4; mft-cmd publishes operator commands and pushes).
+# Who may publish / subscribe what (docs/architecture.md#topics; mft-cmd publishes operator commands and pushes).
 declare -A PUB=(
   [sim]="SensorData GroundTruth CommandVerdict"
   [estimator]="RobotState"
@@ -84,7 +84,7 @@ declare -A SUB=(
 )
 
 echo "make-security: test CA and ${#IDENTITIES[@]} identities in $DIR (profile $PROFILE, $DAYS days)"
-# EC P-256 everywhere (DDS.md section 7: works with Fast DDS 2.9.1 and OpenSSL 3).
+# EC P-256 everywhere (docs/dds.md#security: works with Fast DDS 2.9.1 and OpenSSL 3).
 openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -keyout ca.key -out ca.pem \
   -days "$DAYS" -sha256 -subj "/C=DE/O=mft-wbc/CN=${CN_PREFIX}mft-wbc test CA" 2>/dev/null
 for id in "${IDENTITIES[@]}"; do
@@ -143,7 +143,7 @@ for id in "${IDENTITIES[@]}"; do
     echo '<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="omg_shared_ca_permissions.xsd">'
     echo '  <permissions>'
     echo "    <grant name=\"${id}_grant\">"
-    # RFC 2253 order, the reverse of the -subj string (DDS.md trap 2).
+    # RFC 2253 order, the reverse of the -subj string (docs/dds.md#security, trap 2).
     echo "      <subject_name>CN=${CN_PREFIX}${id}, O=mft-wbc, C=DE</subject_name>"
     echo "      <validity><not_before>$NOT_BEFORE</not_before><not_after>$NOT_AFTER</not_after></validity>"
     echo '      <allow_rule>'

@@ -1,5 +1,5 @@
 #pragma once
-// LTI of one leg from its generalized coordinates (MFT-THEORY.md 1.3). Local copy until model/ provides
+// LTI of one leg from its generalized coordinates (docs/five-bar-theory.md#transmission-indices-lti). Local copy until model/ provides
 // the MFT indices: LTI = min(|sin knee_rear|, |sin knee_fore|, |sin(shank_fore - shank_rear)|).
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// LTI of a leg straight from the generalized coordinates (MFT-THEORY.md 1.3):
+// LTI of a leg straight from the generalized coordinates (docs/five-bar-theory.md#transmission-indices-lti):
 // min(|sin knee_rear|, |sin knee_fore|, |sin(shank_fore - shank_rear)|), shank = hip + knee (absolute).
 #include <algorithm>
 #include <cmath>

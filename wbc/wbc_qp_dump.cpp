@@ -1,4 +1,4 @@
-// WholeBodyController::writeLastQp: the last tick's QP in the shared WBCQP v1 format (shared/qp/FORMAT.md).
+// WholeBodyController::writeLastQp: the last tick's QP in the WBCQP v1 format (docs/qp-instances.md#file-format).
 #include <cstdio>
 #include <stdexcept>
 
@@ -7,13 +7,13 @@
 
 namespace mft::wbc {
 
-void WholeBodyController::writeLastQp(const std::string& path) const {
+void WholeBodyController::writeLastQp(const std::string& path, const std::string& name) const {
   if (!has_problem_) throw std::runtime_error("WBC: no QP has been assembled yet, nothing to write to " + path);
   qp::QpInstance inst;
   inst.problem = problem_;
-  char name[32];
-  std::snprintf(name, sizeof name, "wbc_%05llu", static_cast<unsigned long long>(problem_tick_));
-  inst.name = name;
+  char default_name[32];
+  std::snprintf(default_name, sizeof default_name, "wbc_%05llu", static_cast<unsigned long long>(problem_tick_));
+  inst.name = name.empty() ? std::string(default_name) : name;
   inst.step = static_cast<long long>(problem_tick_);
   for (VarBlock b : {VarBlock::Qdd, VarBlock::Fc, VarBlock::Eps})
     inst.varblocks.push_back({toString(b), blockOffset(b), blockSize(b)});

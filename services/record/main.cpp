@@ -271,7 +271,7 @@ int main(int argc, char** argv) {
   services::ServiceContext::declareOptions(cli);
   cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>); an existing recording is refused", "", true);
   cli.flag("overwrite", "replace an existing recording at --output (its sidecar and pieces too)");
-  cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (RAWLOG.md)", "1");
+  cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (docs/mrpt.md#compression-level)", "1");
   cli.option("flush-ms", "flush period: a crash loses about this much [ms] (at most 100)", "50");
   cli.option("queue", "capacity of the queue between DDS and the writer [messages]", "65536");
   cli.option("split-mb", "start a new piece past this compressed size [MB] (0 = never)", "0");
@@ -417,7 +417,7 @@ int main(int argc, char** argv) {
     auto flowing = [&] { return r0.received() && r1.received() && r2.received() && r3.received() && r4.received() && r5.received(); };
     auto publishProgress = [&] {
       // Nothing until every 1 kHz topic flows: the simulator holds tick 0 until then, so that no writer's
-      // first samples go out before it has matched the recorder (DDS.md G13).
+      // first samples go out before it has matched the recorder (docs/dds.md#samples-before-matching).
       if (!lockstep || !flowing()) return;
       // The newest tick seen on any topic: the socket is a FIFO, so everything sent before it has been taken
       // in (or was lost, and waiting for it would deadlock the run).

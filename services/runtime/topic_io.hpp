@@ -1,7 +1,7 @@
 #pragma once
 // Typed topic writers and readers on a DdsParticipant, created from a named QoS profile.
 // The reader delivers every valid sample to a callback on the DDS receive thread (the cheapest path at
-// 1 kHz, DDS.md section 1) and counts deadline misses, liveliness changes and matched writers.
+// 1 kHz, docs/dds.md#transport-and-qos) and counts deadline misses, liveliness changes and matched writers.
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>

@@ -1,4 +1,4 @@
-// mft-sim: the ODE simulator as a service. It owns the clock (ARCHITECTURE.md section 3):
+// mft-sim: the ODE simulator as a service. It owns the clock (docs/architecture.md#clock-and-loop-modes):
 //  lockstep: publish GroundTruth(k) and SensorData(k), wait for JointCommand(k), step; deterministic, as fast
 //            as the chain answers; a missing answer is a named timeout error (exit status 3).
 //  realtime: step on the wall clock at 1 kHz (absolute deadlines), apply the latest command (zero-order hold);
@@ -375,7 +375,7 @@ int main(int argc, char** argv) {
     if (ctx.lockstep()) {
       // Wait for JointCommand(k); re-send tick k when it is late. The chain is best effort (a lost sample
       // costs one re-send instead of reliable QoS on every hop), samples written just after matching can be
-      // lost (DDS.md G13), and every service answers a repeated tick with its cached answer.
+      // lost (docs/dds.md#samples-before-matching), and every service answers a repeated tick with its cached answer.
       std::unique_lock<std::mutex> lock(mutex);
       const auto deadline = Clock::now() + std::chrono::duration<double>(k == 0 ? start_timeout_s : command_timeout_s);
       // Tick 0 of a recorded run is held (and re-sent) until the recorder receives every topic.

@@ -1,5 +1,5 @@
 // mft-wbc: RobotState(k) + Reference(k) -> MFT-WBC (Problem 1, eq. 7, safety stage) -> JointCommand(k) and
-// WbcDiagnostics(k). It answers tick k only when it holds both inputs for k (ARCHITECTURE.md section 3); the
+// WbcDiagnostics(k). It answers tick k only when it holds both inputs for k (docs/architecture.md#clock-and-loop-modes); the
 // controller variant (mft, sa, none) comes from the scenario, everything else from config/wbc.yaml and the
 // MFT polytope of config/mft_space.yaml (refused if it was made for another robot description).
 #include <chrono>

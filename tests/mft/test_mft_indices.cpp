@@ -1,4 +1,4 @@
-// LTI (paper eq. 3-4): the closed forms of MFT-THEORY.md 1.3 against an independent screw-theory computation
+// LTI (paper eq. 3-4): the closed forms of docs/five-bar-theory.md#transmission-indices-lti against an independent screw-theory computation
 // (reciprocal products of the transmission wrench with the input and output twists, maxima by sampling force
 // directions), and singular configurations giving 0 without NaN.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Leg inertia M_a against kinetic energy from finite differences of the kinematics; RACI against the
-// massless-link closed form of MFT-THEORY.md 2.3, and the vertical stance numbers of section 4.3.
+// massless-link closed form of docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia, and the vertical stance numbers of docs/five-bar-theory.md#vertical-stance-numbers.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -131,7 +131,7 @@ TEST(MftRaci, SingularConfigurationsAreInfiniteNotNaN) {
 }
 
 TEST(MftRaci, VerticalStanceTableOfTheDesignNotes) {
-  // MFT-THEORY.md 4.3: z_B, ITI, OTI, LTI, RACI* (optimal), RACI (k = 0.3), RACI* with gravity.
+  // docs/five-bar-theory.md#vertical-stance-numbers: z_B, ITI, OTI, LTI, RACI* (optimal), RACI (k = 0.3), RACI* with gravity.
   struct Row {
     double z, iti, oti, lti, opt, fixed, grav;
   };

@@ -220,7 +220,9 @@ TEST(MotionPlanner, LateTouchdownFollowsTheCom) {
       else {
         ++extended_ticks;
         const double x = plan.foot[0].pos.x();
-        if (extended_ticks > 1) EXPECT_LE(std::abs(x - last_x), speed * kDt + 1e-12);  // bounded foot speed
+        if (extended_ticks > 1) {
+          EXPECT_LE(std::abs(x - last_x), speed * kDt + 1e-12);  // bounded foot speed
+        }
         last_x = x;
       }
       r.step(plan);

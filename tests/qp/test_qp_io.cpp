@@ -1,4 +1,5 @@
-// WBCQP v1 reader/writer: bit-exact round trip of the shared instances, and loud failures on malformed files.
+// WBCQP v1 reader/writer: bit-exact round trip of the project's instance set (tests/data/qp), and loud failures on
+// malformed files.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -6,15 +7,14 @@
 #include <fstream>
 #include <sstream>
 
+#include "qp_instance_set.hpp"
 #include "wbc/qp/qp_io.hpp"
 
 using namespace mft::qp;
 
 namespace {
 
-std::string sharedFile(const char* name) {
-  return std::string(MFT_SHARED_DIR) + "/qp/instances/seq_1600_1799/" + name;
-}
+std::string setFile(const char* name) { return mft::qp::testing::instanceDir() + "/" + name; }
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -73,14 +73,18 @@ const char* kSmall =
 
 }  // namespace
 
-TEST(QpIo, ReadsASharedInstance) {
-  const QpInstance inst = readQpInstance(sharedFile("wbc_01600.txt"));
-  EXPECT_EQ(inst.name, "wbc_01600");
-  EXPECT_EQ(inst.step, 1600);
+TEST(QpIo, ReadsAnInstanceOfTheSet) {
+  // The first single-support tick of the MFT-WBC stepping run: the right foot swings.
+  const QpInstance inst = readQpInstance(setFile("step_mft_01000.txt"));
+  EXPECT_EQ(inst.name, "step_mft_01000");
+  EXPECT_EQ(inst.step, 1000);
   EXPECT_EQ(inst.problem.n, 27);
   EXPECT_EQ(inst.problem.neq, 7);
   EXPECT_EQ(inst.problem.nin, 20);
-  EXPECT_EQ(inst.problem.dense_block, 11);
+  // Detected from H: the qdd block is dense up to the last joint with an off-diagonal entry at this tick.
+  EXPECT_EQ(inst.problem.dense_block, detectDenseBlock(inst.problem.H));
+  EXPECT_GE(inst.problem.dense_block, 3);
+  EXPECT_LE(inst.problem.dense_block, 11);
   ASSERT_EQ(inst.varblocks.size(), 3u);
   EXPECT_EQ(inst.varblocks[2].name, "eps");
   EXPECT_EQ(inst.rowblocks.size(), 5u);
@@ -88,17 +92,19 @@ TEST(QpIo, ReadsASharedInstance) {
   EXPECT_EQ(inst.problem.lb[15], -kInf);
   EXPECT_EQ(inst.problem.ub[15], kInf);
   EXPECT_EQ(inst.problem.lb[12], inst.problem.ub[12]);  // swing foot f_z fixed
+  EXPECT_EQ(inst.problem.lb[14], 0.0);                  // stance foot 0 <= f_z <= 1000 N
+  EXPECT_EQ(inst.problem.ub[14], 1000.0);
 }
 
-TEST(QpIo, WriterReproducesTheSharedFilesByteForByte) {
-  for (const char* f : {"wbc_01600.txt", "wbc_01750.txt", "wbc_01799.txt"}) {
-    const std::string text = slurp(sharedFile(f));
+TEST(QpIo, WriterReproducesTheSetFilesByteForByte) {
+  for (const std::string& f : listQpInstanceFiles(mft::qp::testing::instanceDir())) {
+    const std::string text = slurp(f);
     EXPECT_EQ(formatQpInstance(parseQpInstance(text, f)), text) << f;
   }
 }
 
 TEST(QpIo, RoundTripThroughAFileIsBitExact) {
-  QpInstance a = readQpInstance(sharedFile("wbc_01700.txt"));
+  QpInstance a = readQpInstance(setFile("push_mft_03460.txt"));
   // Values %.6g would lose, infinities, and no optional records.
   a.problem.g[0] = 0.1 + 0.2;
   a.problem.beq[0] = -1e-300;

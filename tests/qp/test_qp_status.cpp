@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "qp_instance_set.hpp"
 #include "qp_reference.hpp"
 #include "wbc/qp/qp_io.hpp"
 #include "wbc/qp/qp_kkt.hpp"
@@ -33,8 +34,25 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
-QpInstance sharedInstance(const char* name) {
-  return readQpInstance(std::string(MFT_SHARED_DIR) + "/qp/instances/seq_1600_1799/" + name);
+using mft::qp::testing::instanceSet;
+
+// MFT-WBC instances of the set (27 variables, 7 equalities, 20 rows), in file order.
+std::vector<QpInstance> mftInstances() {
+  std::vector<QpInstance> v;
+  for (const QpInstance& inst : instanceSet())
+    if (inst.problem.n == 27 && inst.problem.neq == 7 && inst.problem.nin == 20) v.push_back(inst);
+  return v;
+}
+
+// The MFT-WBC instance whose cold solve needs the most working-set changes (the first of equals).
+QpInstance hardestInstance() {
+  GoldfarbIdnaniSolver s;
+  QpSolution sol;
+  QpInstance best;
+  int most = -1;
+  for (const QpInstance& inst : mftInstances())
+    if (s.solve(inst.problem, &sol) == QpStatus::Optimal && sol.iterations > most) most = sol.iterations, best = inst;
+  return best;
 }
 
 QpProblem unconstrained(int n, int block, unsigned seed) {
@@ -51,7 +69,7 @@ QpProblem unconstrained(int n, int block, unsigned seed) {
 }  // namespace
 
 TEST(QpStatus, UnconstrainedStartIsMinusHInverseG) {
-  // QP.md: eiquadprog's provided-factor path returns +J J' g. Ours must give -H^-1 g, dense or block-structured.
+  // docs/qp.md#unconstrained-start: eiquadprog's provided-factor path returns +J J' g. Ours must give -H^-1 g, dense or block-structured.
   for (int block : {6, 3, 1}) {
     QpProblem p = unconstrained(6, block, 10 + block);
     const Eigen::VectorXd expected = -p.H.llt().solve(p.g);
@@ -77,7 +95,8 @@ TEST(QpStatus, WrongBlockHintFallsBackToDense) {
 }
 
 TEST(QpStatus, NonFiniteDataIsANumericalFailure) {
-  const QpInstance inst = sharedInstance("wbc_01690.txt");
+  ASSERT_FALSE(mftInstances().empty());
+  const QpInstance inst = mftInstances().front();
   GoldfarbIdnaniSolver s;
   QpSolution sol;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -116,8 +135,7 @@ TEST(QpStatus, NonPositiveDefiniteHIsANumericalFailure) {
 }
 
 TEST(QpStatus, IterationCapYieldsIterationLimit) {
-  // wbc_01605 needs several working-set changes.
-  const QpInstance inst = sharedInstance("wbc_01605.txt");
+  const QpInstance inst = hardestInstance();
   GoldfarbIdnaniSolver s;
   QpSolution sol;
   ASSERT_EQ(s.solve(inst.problem, &sol), QpStatus::Optimal);
@@ -131,7 +149,7 @@ TEST(QpStatus, IterationCapYieldsIterationLimit) {
   // Warm start that hits the cap falls back to cold, which hits it too.
   GoldfarbIdnaniSolver w;
   w.options().warm_start = true;
-  ASSERT_EQ(w.solve(sharedInstance("wbc_01750.txt").problem, &sol), QpStatus::Optimal);
+  ASSERT_EQ(w.solve(mftInstances().back().problem, &sol), QpStatus::Optimal);
   w.options().max_iterations = 0;
   EXPECT_EQ(w.solve(inst.problem, &sol), QpStatus::IterationLimit);
   w.options().max_iterations = 200;
@@ -139,9 +157,9 @@ TEST(QpStatus, IterationCapYieldsIterationLimit) {
 }
 
 TEST(QpStatus, SolveAllocatesNothingOnceSized) {
-  std::vector<QpInstance> seq;
-  for (const char* f : {"wbc_01600.txt", "wbc_01605.txt", "wbc_01681.txt", "wbc_01750.txt", "wbc_01779.txt"})
-    seq.push_back(sharedInstance(f));
+  // Every MFT-WBC instance of the set: same sizes, many different active sets.
+  const std::vector<QpInstance> seq = mftInstances();
+  ASSERT_GE(seq.size(), 20u);
   for (bool warm : {false, true}) {
     GoldfarbIdnaniSolver s(27, 7, 20);
     s.options().warm_start = warm;
@@ -160,7 +178,7 @@ TEST(QpStatus, SolveAllocatesNothingOnceSized) {
 }
 
 TEST(QpStatus, SolutionConventions) {
-  const QpInstance inst = sharedInstance("wbc_01681.txt");
+  const QpInstance inst = hardestInstance();
   GoldfarbIdnaniSolver s;
   QpSolution sol;
   ASSERT_EQ(s.solve(inst.problem, &sol), QpStatus::Optimal);
@@ -187,7 +205,7 @@ TEST(QpStatus, SolutionConventions) {
 }
 
 TEST(QpStatus, KktCheckerDetectsEachViolation) {
-  const QpInstance inst = sharedInstance("wbc_01681.txt");
+  const QpInstance inst = hardestInstance();
   GoldfarbIdnaniSolver s;
   QpSolution sol;
   ASSERT_EQ(s.solve(inst.problem, &sol), QpStatus::Optimal);
@@ -197,12 +215,13 @@ TEST(QpStatus, KktCheckerDetectsEachViolation) {
   EXPECT_GT(kktResiduals(inst.problem, bad).stationarity, 1e-5);
   bad = sol;
   bad.x[16] = 1e3;  // eps, also breaks stationarity; and qdd beyond its box:
-  bad.x[3] = 100.0;
-  EXPECT_GE(kktResiduals(inst.problem, bad).primal, 78.0);
+  bad.x[3] = inst.problem.ub[3] + 80.0;
+  EXPECT_GE(kktResiduals(inst.problem, bad).primal, 79.9);
   bad = sol;
   bad.y_bounds[20] = 1.0;  // eps has no bounds: any multiplier is dual-infeasible
   EXPECT_GE(kktResiduals(inst.problem, bad).dual, 1.0);
   bad = sol;
+  ASSERT_GT(sol.x[0] - inst.problem.lb[0], 1.0);
   bad.y_bounds[0] = 1.0;  // lower bound of qdd_0 is not tight
   EXPECT_GT(kktResiduals(inst.problem, bad).complementarity, 1.0);
 }

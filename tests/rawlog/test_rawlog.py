@@ -138,7 +138,7 @@ class RecordedLockstepRun(unittest.TestCase):
     def test_2_rawlog_edit_lists_every_label_with_its_count(self):
         if not shutil.which("rawlog-edit"):
             self.skipTest("rawlog-edit (mrpt-apps) not installed")
-        # rawlog-edit writes side files next to its input's folder (RAWLOG.md 5): run it in the file's folder.
+        # rawlog-edit writes side files next to its input's folder (docs/mrpt.md#rawlog-edit): run it in the file's folder.
         p = run(["rawlog-edit", "--info", "-i", self.rawlog.name], cwd=self.rawlog.parent, timeout=120)
         self.assertEqual(p.returncode, 0, p.stderr)
         counts = {m.group(1): int(m.group(2)) for m in

@@ -43,7 +43,7 @@ TEST(DdsRuntime, SamplesFlowInOrderAndDeadlineMissesAreCounted) {
   EXPECT_GE(reader.received(), 190u);  // best effort on loopback: at most a handful lost on a busy machine
   EXPECT_EQ(out_of_order.load(), 0u);
   const auto misses_while_flowing = reader.requestedDeadlineMisses();
-  // The writer stops: the 3 ms deadline must fire (about every 2 ms, DDS.md section 4).
+  // The writer stops: the 3 ms deadline must fire (about every 2 ms, docs/dds.md#deadline-and-liveliness-timing).
   std::this_thread::sleep_for(50ms);
   EXPECT_GT(reader.requestedDeadlineMisses(), misses_while_flowing + 5);
 }
@@ -91,7 +91,7 @@ TEST(PollingReceive, BurstsArriveWholeInOrderAndInBatches) {
   SensorReader reader_b(second, "SensorData", "control_reader", counter(b));
   SensorWriter writer(sim, "SensorData", "control_writer");
   ASSERT_TRUE(waitUntil([&] { return writer.matched() == 2 && reader_a.matched() == 1 && reader_b.matched() == 1; }, 5000ms));
-  std::this_thread::sleep_for(20ms);  // samples written in the instant of matching may be lost (DDS.md G13)
+  std::this_thread::sleep_for(20ms);  // samples written in the instant of matching may be lost (docs/dds.md#samples-before-matching)
 
   const std::uint64_t datagrams_before = stats.datagrams.load();
   mft::msg::SensorData m;

@@ -4,7 +4,9 @@
 //   mft-closedloop --scenario config/scenarios/demo.yaml --json
 //   mft-closedloop --height 0.44 --controller sa --duration 20 --csv /tmp/step.csv
 //   mft-closedloop --speed 0.3 --duration 20 --estimator ground_truth
+//   mft-closedloop --stand --height 0.40 --duration 2 --dump-qp tests/data/qp --dump-from 1.5 --dump-count 20
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "model/config/strict_yaml.hpp"
@@ -42,6 +44,11 @@ int main(int argc, char** argv) {
   cli.option("csv", "write a per-tick trace to this CSV file");
   cli.option("csv-every", "write every n-th tick to the CSV", "1");
   cli.flag("json", "print the summary as JSON (default: a short text summary)");
+  cli.option("dump-qp", "write the WBC's QP of the ticks in the dump window to this existing folder as WBCQP files "
+             "(docs/qp-instances.md)");
+  cli.option("dump-from", "with --dump-qp: first tick of the window, as sim time [s]", "0.0");
+  cli.option("dump-count", "with --dump-qp: number of consecutive ticks", "1");
+  cli.option("dump-name", "with --dump-qp: instance name prefix; files are <prefix>_<tick>.txt", "wbc");
   cli.parse(argc, argv);
 
   closedloop::Configs configs;
@@ -110,10 +117,39 @@ int main(int argc, char** argv) {
     if (!csv) cli.fail("cannot write " + cli.get("csv"));
     csv << closedloop::ClosedLoop::csvHeader() << "\n";
   }
+  // QP dump window in ticks; writing files is fine here: this loop runs on the sim clock, not in real time.
+  const bool dump = cli.isSet("dump-qp");
+  const std::string dump_dir = cli.get("dump-qp"), dump_name = cli.get("dump-name");
+  std::uint64_t dump_first = 0, dump_end = 0, dumped = 0;
+  if (dump) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dump_dir, ec)) cli.fail("--dump-qp: not a folder: " + dump_dir);
+    if (dump_name.empty() || dump_name.find('/') != std::string::npos) cli.fail("--dump-name: expected a plain name");
+    dump_first = static_cast<std::uint64_t>(
+        std::llround(cli.getDouble("dump-from", 0.0, 3600.0) / configs.sim.control_period_s));
+    dump_end = dump_first + static_cast<std::uint64_t>(cli.getInt("dump-count", 1, 100000));
+  }
+  std::string dump_error;
   long n = 0;
   const auto& s = loop->run([&](const closedloop::ClosedLoop& l) {
     if (csv.is_open() && n++ % every == 0) csv << l.csvRow() << "\n";
+    const wbc::WholeBodyController& c = l.controller();
+    if (!dump || !dump_error.empty() || !c.hasLastProblem()) return;
+    const std::uint64_t tick = c.lastProblemTick();
+    if (tick < dump_first || tick >= dump_end || tick < dump_first + dumped) return;
+    char name[160];
+    std::snprintf(name, sizeof name, "%s_%05llu", dump_name.c_str(), static_cast<unsigned long long>(tick));
+    try {
+      c.writeLastQp(dump_dir + "/" + name + ".txt", name);
+      dumped = tick - dump_first + 1;
+    } catch (const std::exception& e) {
+      dump_error = e.what();
+    }
   });
+  if (!dump_error.empty()) cli.fail("--dump-qp: " + dump_error);
+  if (dump && dumped < dump_end - dump_first)
+    cli.fail("--dump-qp: the run ended before the dump window did (" + std::to_string(dumped) + " of " +
+             std::to_string(dump_end - dump_first) + " ticks written)");
 
   if (cli.isSet("json")) {
     std::printf("{\"scenario\": %s, \"summary\": %s, \"recovery\": %s}\n", scenario.toJson().c_str(),

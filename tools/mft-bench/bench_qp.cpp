@@ -1,6 +1,6 @@
-// QP solver latency on the 200 shared WBC instances (shared/qp/instances/seq_1600_1799), solved in file-name
+// QP solver latency on the project's QP instance set (tests/data/qp, docs/qp-instances.md), solved in file-name
 // order, one solve per benchmark iteration, only the solve() call timed (mean / p50 / p99 / max in us).
-// mft-qp bench reports the same with the per-step minimum over passes (QP.md section 1).
+// mft-qp bench reports the same with the per-step minimum over passes (docs/qp.md#measuring-solve-time).
 #include <benchmark/benchmark.h>
 
 #include <string>
@@ -18,7 +18,7 @@ const std::vector<QpInstance>& qpInstances() {
   static const std::vector<QpInstance> instances = [] {
     std::vector<QpInstance> v;
     try {
-      for (const std::string& f : listQpInstanceFiles(std::string(MFT_SHARED_DIR) + "/qp/instances/seq_1600_1799"))
+      for (const std::string& f : listQpInstanceFiles(MFT_QP_INSTANCE_DIR))
         v.push_back(readQpInstance(f));
     } catch (const QpIoError&) {
       v.clear();
@@ -28,10 +28,13 @@ const std::vector<QpInstance>& qpInstances() {
   return instances;
 }
 
+// Instances are named <run>_<tick>.
+std::string runOf(const QpInstance& inst) { return inst.name.substr(0, inst.name.rfind('_')); }
+
 void solveSequence(benchmark::State& state, bool warm) {
   const auto& instances = qpInstances();
   if (instances.empty()) {
-    state.SkipWithError("no QP instances in shared/qp/instances/seq_1600_1799");
+    state.SkipWithError("no QP instances in " MFT_QP_INSTANCE_DIR);
     return;
   }
   const QpProblem& first = instances.front().problem;
@@ -43,10 +46,9 @@ void solveSequence(benchmark::State& state, bool warm) {
   std::size_t k = 0;
   long failures = 0;
   for (auto _ : state) {
-    if (k == instances.size()) {
-      k = 0;
-      solver.clearWarmStart();  // the sequence restarts: no meaningful previous active set
-    }
+    if (k == instances.size()) k = 0;
+    // A new run (or the sequence restarting) has no meaningful previous active set.
+    if (k == 0 || runOf(instances[k]) != runOf(instances[k - 1])) solver.clearWarmStart();
     QpStatus status = QpStatus::Optimal;
     recorder.time([&] { status = solver.solve(instances[k].problem, &solution); });
     failures += status == QpStatus::Optimal ? 0 : 1;
@@ -60,7 +62,7 @@ void solveSequence(benchmark::State& state, bool warm) {
 void BM_QpGoldfarbIdnaniCold(benchmark::State& state) { solveSequence(state, false); }
 void BM_QpGoldfarbIdnaniWarm(benchmark::State& state) { solveSequence(state, true); }
 
-// 10 passes over the 200 instances.
+// About 10 passes over the instance set.
 BENCHMARK(BM_QpGoldfarbIdnaniCold)->Iterations(2000)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_QpGoldfarbIdnaniWarm)->Iterations(2000)->Unit(benchmark::kMicrosecond);
 

@@ -62,6 +62,9 @@ Accuracy checkSolution(const QpInstance& inst, const QpSolution& s) {
   return a;
 }
 
+// The run of an instance named <run>_<tick> (docs/qp-instances.md): the name without its last "_<suffix>".
+std::string runName(const std::string& name) { return name.substr(0, name.rfind('_')); }
+
 std::vector<QpInstance> loadFolder(const std::string& dir) {
   const std::vector<std::string> files = qp::listQpInstanceFiles(dir);
   if (files.empty()) throw qp::QpIoError(dir + ": no *.txt instances");
@@ -71,7 +74,7 @@ std::vector<QpInstance> loadFolder(const std::string& dir) {
   return out;
 }
 
-// Real-time hygiene as in QP.md section 1; every step degrades gracefully and is reported.
+// Real-time hygiene as in docs/qp.md#measuring-solve-time; every step degrades gracefully and is reported.
 std::string prepareProcess(int cpu) {
   std::string notes;
   mallopt(M_MMAP_MAX, 0);
@@ -147,6 +150,8 @@ int runBench(const BenchOptions& o) {
     QpSolution sol;
     sol.resize(first.n, first.neq, first.nin);
     for (std::size_t k = 0; k < count; ++k) {
+      // Instances named <run>_<tick> form runs of consecutive ticks: a new run starts without warm-start state.
+      if (k > 0 && runName(instances[k].name) != runName(instances[k - 1].name)) solver.clearWarmStart();
       const auto t0 = std::chrono::steady_clock::now();
       const QpStatus st = solver.solve(instances[k].problem, &sol);
       const auto t1 = std::chrono::steady_clock::now();

@@ -228,7 +228,7 @@ class Publisher {
   std::unique_ptr<services::TopicWriter<msg::Disturbance, msg::DisturbancePubSubType>> db_;
 };
 
-// A read-ahead thread keeps file I/O and decoding off the pacing thread (RAWLOG.md 4: I/O hiccups).
+// A read-ahead thread keeps file I/O and decoding off the pacing thread (docs/mrpt.md#write-stalls-and-flushing: I/O hiccups).
 class ReadAhead {
  public:
   ReadAhead(rawlog::RawlogReader& reader, const std::set<rawlog::Topic>& topics, double start_s, double duration_s)

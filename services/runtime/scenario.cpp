@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "model/config/strict_yaml.hpp"
+#include "model/config/tool_io.hpp"
 
 namespace mft::services {
 
@@ -103,18 +104,7 @@ Scenario parseScenario(const std::string& yaml_text, const std::string& origin) 
 }
 
 std::string Scenario::toJson() const {
-  auto esc = [](const std::string& in) {
-    std::string out;
-    for (char c : in) {
-      if (c == '"' || c == '\\') out += '\\';
-      if (c == '\n') {
-        out += "\\n";
-        continue;
-      }
-      out += c;
-    }
-    return out;
-  };
+  const auto esc = config::jsonEscape;
   std::ostringstream o;
   o.precision(17);
   o << "{\"name\": \"" << esc(name) << "\", \"file\": \"" << esc(source_file) << "\", \"duration_s\": " << duration_s

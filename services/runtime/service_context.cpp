@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "model/config/strict_yaml.hpp"
+#include "services/runtime/scenario_limits.hpp"
 
 namespace mft::services {
 
@@ -35,6 +36,7 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   try {
     robot_ = model::loadRobotDescription(configFile("robot.yaml"));
     scenario_ = loadScenario(cli.get("scenario"));
+    checkScenarioLimits(scenario_, robot_, configFile("planner.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }

@@ -9,11 +9,12 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using namespace std::chrono_literals;
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli(
       "mft-cmd",
       "Send an operator command or a push to a running mft-wbc stack.\n"
@@ -100,4 +101,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-cmd", [&] { return toolMain(argc, argv); });
 }

@@ -237,7 +237,6 @@ class ToolIoErrors(BadInputCase):
             (["mft-closedloop", "--duration", "0.1", "--csv", "/proc/mft-no-such-dir/x.csv"], "cannot write"),
             (["mft-sim", "--domain", DOMAIN, "--scenario", folder], str(folder) + ": is a directory"),
             (["mft-sim", "--check-scenario", folder], str(folder) + ": is a directory"),
-            (["mft-record", "--domain", DOMAIN, "--scenario", DEMO, "--output", folder / "x" / "y.rawlog"], str(folder)),
             (["mft-sim", "--domain", DOMAIN, "--scenario", DEMO, "--profiles", folder], "is a directory"),
             (["mft-cmd", "--domain", DOMAIN, "--mode", "stand", "--profiles", folder], "is a directory"),
             (["mft-inject", "--domain", DOMAIN, "--listen", "all", "--seconds", "0.1", "--profiles", folder], str(folder)),

@@ -162,6 +162,9 @@ class ObjectBounds {
       return;
     } else if (cls == "mrpt::obs::CObservationIMU" && depth == 0) {
       if (version != 4) refuseVersion();
+      // TODO(issue 16): MRPT 2.5.8 writes the nested CPose3D at serialization version 3, whose layout is not
+      // pinned by a test yet: the IMU's only length (sensorLabel) is left unchecked until it is.
+      return;
       object(depth + 1);                            // sensorPose
       skip(mrpt::obs::COUNT_IMU_DATA_FIELDS * sizeof(bool) + 8 + mrpt::obs::COUNT_IMU_DATA_FIELDS * 8);
       array(what, "sensorLabel", 1);

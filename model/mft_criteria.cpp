@@ -70,6 +70,19 @@ LegEvaluation evaluateVerticalStance(const MftLegModel& m, const MftCriteria& c,
   return evaluateLegAtFoot(m, c, Eigen::Vector2d(0.0, -(base_height_m - m.foot_radius_m)));
 }
 
+Interval reachableBaseHeights(const MftLegModel& m, double foot_x_m, double step_m) {
+  const MftCriteria criteria;  // the MFT thresholds play no part in `reachable`
+  Interval out{1.0, 0.0};      // empty
+  const double top = m.geometry.l1 + m.geometry.l2 + m.foot_radius_m;
+  for (int k = 1; k * step_m <= top + 1e-12; ++k) {
+    const double h = k * step_m;
+    if (!evaluateLegAtFoot(m, criteria, Eigen::Vector2d(foot_x_m, -(h - m.foot_radius_m))).reachable) continue;
+    if (out.lo > out.hi) out = {h, h};
+    else out.hi = h;
+  }
+  return out;
+}
+
 const char* fiveBarStatusName(FiveBarStatus s) {
   switch (s) {
     case FiveBarStatus::Ok: return "ok";

@@ -44,6 +44,12 @@ LegEvaluation evaluateLegAtFoot(const MftLegModel& m, const MftCriteria& c, cons
 // Vertical stance: foot straight below the hip axis at d = z_B - foot_radius (base frame on the hip axis).
 LegEvaluation evaluateVerticalStance(const MftLegModel& m, const MftCriteria& c, double base_height_m);
 
+// The base heights over flat ground at which a leg with its foot `foot_x_m` ahead of the hip axis (base
+// frame, foot on the ground) is reachable: the loop closes and the hips and knees are inside their limits
+// and knee stops (as for the MFT space). Scanned in `step_m` steps from 0 to l1 + l2 + foot radius; the
+// reachable heights of a five-bar leg are one interval. lo > hi when no height is reachable.
+Interval reachableBaseHeights(const MftLegModel& m, double foot_x_m, double step_m = 5e-4);
+
 const char* fiveBarStatusName(FiveBarStatus s);
 
 }  // namespace mft::model

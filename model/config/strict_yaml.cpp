@@ -5,6 +5,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <map>
 
 namespace mft::config {
@@ -41,6 +43,8 @@ StrictNode StrictNode::loadString(const std::string& text, const std::string& or
 StrictNode StrictNode::loadFile(const std::string& path) {
   auto impl = std::make_unique<Impl>();
   impl->file = path;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a directory, not a YAML file");
   try {
     impl->node = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
@@ -140,10 +144,29 @@ double StrictNode::nonNegative(const std::string& key) {
   return v;
 }
 
-double StrictNode::inRange(const std::string& key, double lo, double hi) {
+namespace {
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+}  // namespace
+
+double StrictNode::inRange(const std::string& key, double lo, double hi, const std::string& unit) {
   const double v = number(key);
   if (!(v >= lo && v <= hi))
-    fail(key, "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "] (got " + std::to_string(v) + ")");
+    fail(key, "must lie in [" + shortNumber(lo) + ", " + shortNumber(hi) + "]" + (unit.empty() ? "" : " " + unit) +
+                  " (got " + shortNumber(v) + ")");
+  return v;
+}
+
+std::vector<double> StrictNode::numbersInRange(const std::string& key, std::size_t expected_size, double lo, double hi,
+                                               const std::string& unit) {
+  const auto v = numbers(key, expected_size);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    if (!(v[i] >= lo && v[i] <= hi))
+      fail(key, "element " + std::to_string(i) + " must lie in [" + shortNumber(lo) + ", " + shortNumber(hi) + "]" +
+                    (unit.empty() ? "" : " " + unit) + " (got " + shortNumber(v[i]) + ")");
   return v;
 }
 

@@ -45,12 +45,23 @@ class StrictNode {
   double number(const std::string& key);
   double positive(const std::string& key);     // > 0
   double nonNegative(const std::string& key);  // >= 0
-  double inRange(const std::string& key, double lo, double hi);  // lo <= v <= hi
+  // lo <= v <= hi, else "must lie in [lo, hi] unit (got v)".
+  double inRange(const std::string& key, double lo, double hi, const std::string& unit = "");
   int integer(const std::string& key);
   bool boolean(const std::string& key);
   std::string text(const std::string& key);
   std::vector<double> numbers(const std::string& key, std::size_t expected_size);  // 0 = any size
   std::vector<std::string> texts(const std::string& key);  // a list of strings
+  // A list of numbers each in [lo, hi] (0 = any size).
+  std::vector<double> numbersInRange(const std::string& key, std::size_t expected_size, double lo, double hi,
+                                     const std::string& unit = "");
+  template <std::size_t N>
+  std::array<double, N> fixedInRange(const std::string& key, double lo, double hi, const std::string& unit = "") {
+    const auto v = numbersInRange(key, N, lo, hi, unit);
+    std::array<double, N> a{};
+    for (std::size_t i = 0; i < N; ++i) a[i] = v[i];
+    return a;
+  }
   template <std::size_t N>
   std::array<double, N> fixed(const std::string& key) {
     const auto v = numbers(key, N);

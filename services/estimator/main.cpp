@@ -16,11 +16,12 @@
 #include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli("mft-estimator", "State estimator service: SensorData -> RobotState.");
   services::ServiceContext::declareOptions(cli);
   cli.parse(argc, argv);
@@ -118,4 +119,9 @@ int main(int argc, char** argv) {
                    ", \"deadline_misses\": " + std::to_string(sensor_reader.requestedDeadlineMisses()) +
                    ", \"update_time_us\": " + update_us.json() + "}");
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-estimator", [&] { return toolMain(argc, argv); });
 }

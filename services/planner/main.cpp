@@ -19,6 +19,7 @@
 #include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -47,7 +48,7 @@ planner::LocomotionMode toPlannerMode(std::uint8_t m) {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli("mft-planner", "Motion planner service: RobotState (+ OperatorCommand) -> Reference.");
   services::ServiceContext::declareOptions(cli);
   cli.parse(argc, argv);
@@ -195,4 +196,9 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + update_us.json() + "}");
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-planner", [&] { return toolMain(argc, argv); });
 }

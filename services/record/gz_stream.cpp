@@ -2,6 +2,8 @@
 
 #include <zlib.h>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -60,7 +62,7 @@ std::uint64_t GzReadStream::compressedPosition() const {
   return file_ ? static_cast<std::uint64_t>(gzoffset(static_cast<gzFile>(file_))) : 0;
 }
 
-size_t GzReadStream::Read(void* buf, size_t n) {
+std::size_t GzReadStream::readFromFile(void* buf, std::size_t n) {
   if (!file_ || eof_ || n == 0) return 0;
   const int r = gzread(static_cast<gzFile>(file_), buf, static_cast<unsigned>(n));
   int errnum = Z_OK;
@@ -69,7 +71,7 @@ size_t GzReadStream::Read(void* buf, size_t n) {
   // zlib flags a truncated stream (Z_BUF_ERROR) as soon as its read-ahead reaches the end of the file, while
   // up to 2 x gzbuffer of decoded data is still waiting in its buffer: the end is only where gzread returns
   // short. Stopping at the flag lost the last ~0.1 s of a recording cut by a crash or a full disk.
-  if (r < 0 || static_cast<size_t>(r) < n) {
+  if (r < 0 || static_cast<std::size_t>(r) < n) {
     eof_ = true;
     if (r < 0 || failed) {
       if (errnum == Z_BUF_ERROR) truncated_ = true;  // "unexpected end of file"
@@ -77,8 +79,33 @@ size_t GzReadStream::Read(void* buf, size_t n) {
       error_ = msg ? msg : "zlib error";
     }
   }
-  if (r > 0) read_ += static_cast<std::uint64_t>(r);
-  return r > 0 ? static_cast<size_t>(r) : 0;
+  return r > 0 ? static_cast<std::size_t>(r) : 0;
+}
+
+std::size_t GzReadStream::peek(std::size_t n, const unsigned char** data) {
+  if (lookahead_pos_ > 0) {
+    lookahead_.erase(0, lookahead_pos_);
+    lookahead_pos_ = 0;
+  }
+  if (lookahead_.size() < n && !eof_) {
+    const std::size_t have = lookahead_.size();
+    lookahead_.resize(n);
+    lookahead_.resize(have + readFromFile(&lookahead_[have], n - have));
+  }
+  *data = reinterpret_cast<const unsigned char*>(lookahead_.data());
+  return std::min(n, lookahead_.size());
+}
+
+size_t GzReadStream::Read(void* buf, size_t n) {
+  std::size_t got = 0;
+  if (lookahead_pos_ < lookahead_.size()) {
+    got = std::min(n, lookahead_.size() - lookahead_pos_);
+    std::memcpy(buf, lookahead_.data() + lookahead_pos_, got);
+    lookahead_pos_ += got;
+  }
+  if (got < n) got += readFromFile(static_cast<char*>(buf) + got, n - got);
+  read_ += got;
+  return got;
 }
 
 size_t GzReadStream::Write(const void*, size_t) { throw std::runtime_error("GzReadStream: Write"); }

@@ -42,13 +42,17 @@ class GzReadStream : public mrpt::io::CStream {
   ~GzReadStream() override;
   // Throws std::runtime_error if the file cannot be opened. Plain (uncompressed) files pass through.
   void open(const std::string& path);
-  bool eof() const { return eof_; }
+  // The decompressed data is exhausted (nothing left peeked either).
+  bool eof() const { return eof_ && lookahead_pos_ >= lookahead_.size(); }
   // zlib's complaint, if any: "unexpected end of file" for a missing trailer, a data error for corruption.
   bool truncated() const { return truncated_; }
   bool corrupt() const { return corrupt_; }
   const std::string& error() const { return error_; }
   std::uint64_t compressedPosition() const;
   std::uint64_t fileSize() const { return file_size_; }
+  // The next `n` decompressed bytes without consuming them (fewer at the end of the data): the reader bounds
+  // every length of the next object with them before MRPT allocates what the lengths declare.
+  std::size_t peek(std::size_t n, const unsigned char** data);
 
   size_t Read(void* buf, size_t n) override;
   size_t Write(const void*, size_t) override;
@@ -57,8 +61,12 @@ class GzReadStream : public mrpt::io::CStream {
   uint64_t getPosition() const override { return read_; }
 
  private:
+  std::size_t readFromFile(void* buf, std::size_t n);
+
   void* file_ = nullptr;
   std::uint64_t read_ = 0, file_size_ = 0;
+  std::string lookahead_;       // decompressed bytes peeked but not yet read
+  std::size_t lookahead_pos_ = 0;
   bool eof_ = false, truncated_ = false, corrupt_ = false;
   std::string error_;
 };

@@ -37,6 +37,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/scenario.hpp"
 #include "services/runtime/service_context.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 namespace fs = std::filesystem;
@@ -264,7 +265,7 @@ class Subscription : public dds::DataReaderListener {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli("mft-record",
                             "Records every topic to an MRPT rawlog (observations-only format, standard classes,\n"
                             "metadata comment first, sidecar FILE.yaml). See docs/recording.md.");
@@ -487,4 +488,9 @@ int main(int argc, char** argv) {
                                       pollJson(starvation_fallbacks) + ", " +
                                       recorder.summaryJson() + "}");
   return s.error.empty() ? 0 : 1;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-record", [&] { return toolMain(argc, argv); });
 }

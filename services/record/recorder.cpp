@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "services/record/gz_stream.hpp"
+#include "model/config/tool_io.hpp"
 
 namespace mft::rawlog {
 
@@ -321,18 +322,6 @@ RecorderStats Recorder::stats() const {
   return stats_;
 }
 
-namespace {
-// The error text inside a JSON string: no quotes, backslashes or control characters.
-std::string jsonSafe(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
-  }
-  return o;
-}
-}  // namespace
-
 std::string Recorder::summaryJson() const {
   const RecorderStats s = stats();
   std::ostringstream j;
@@ -367,7 +356,7 @@ std::string Recorder::summaryJson() const {
                 s.writer_busy_s > 0 ? static_cast<double>(s.topics[0].written) / s.writer_busy_s : 0.0,
                 s.max_queue_depth, opt_.queue_capacity, static_cast<unsigned long long>(s.flushes),
                 s.max_flush_interval_s * 1e3, static_cast<double>(s.flushed_stamp_ns) * 1e-9,
-                static_cast<unsigned long long>(s.dropped_after_error), jsonSafe(s.error).c_str());
+                static_cast<unsigned long long>(s.dropped_after_error), config::jsonEscape(s.error).c_str());
   std::string pieces = ", \"pieces\": [";
   for (std::size_t i = 0; i < s.pieces.size(); ++i) pieces += (i ? ", \"" : "\"") + s.pieces[i] + "\"";
   return j.str() + buf + pieces + "]";

@@ -6,6 +6,7 @@
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -31,6 +32,8 @@ void loadProfilesOnce(const std::string& file) {
   static std::set<std::string> loaded;
   std::lock_guard<std::mutex> lock(mutex);
   if (loaded.count(file)) return;
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw DdsError("the DDS profile file " + file + " is a directory");
   if (!std::ifstream(file).good()) throw DdsError("cannot open the DDS profile file " + file);
   if (DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK)
     throw DdsError("the DDS profile file " + file + " could not be loaded (malformed XML?)");

@@ -6,6 +6,7 @@
 
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
+#include "model/config/tool_io.hpp"
 
 namespace mft::services {
 
@@ -146,18 +147,7 @@ std::string profilesJson(const std::vector<std::string>& names) {
 }
 
 std::string Scenario::toJson() const {
-  auto esc = [](const std::string& in) {
-    std::string out;
-    for (char c : in) {
-      if (c == '"' || c == '\\') out += '\\';
-      if (c == '\n') {
-        out += "\\n";
-        continue;
-      }
-      out += c;
-    }
-    return out;
-  };
+  const auto esc = config::jsonEscape;
   std::ostringstream o;
   o.precision(17);
   o << "{\"name\": \"" << esc(name) << "\", \"file\": \"" << esc(source_file) << "\", \"duration_s\": " << duration_s

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "model/config/strict_yaml.hpp"
+#include "services/runtime/scenario_limits.hpp"
 
 namespace mft::services {
 
@@ -40,6 +41,7 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
     scenario_ = loadScenario(cli.get("scenario"));
     profile_names_ = activateRunProfiles(config_dir_, scenario_, cli.getAll("profile"));
     robot_ = model::loadRobotDescription(configFile("robot.yaml"));
+    checkScenarioLimits(scenario_, robot_, configFile("planner.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }

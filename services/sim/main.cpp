@@ -27,9 +27,11 @@
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/push_recovery.hpp"
 #include "services/runtime/run_monitor.hpp"
+#include "services/runtime/scenario_limits.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "sim/simulator.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -38,6 +40,14 @@ namespace {
 
 std::int64_t nowNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
+
+// The scenario's initial pose: its base height and stance width, right foot ahead (0: both under the hip).
+sim::StandingPose initialPose(const services::Scenario& scenario) {
+  sim::StandingPose pose;
+  pose.base_height_m = scenario.initial_base_height_m;
+  pose.foot_offset_x_m = {0.5 * scenario.initial_stance_width_m, -0.5 * scenario.initial_stance_width_m};
+  return pose;
 }
 
 // `mft-sim --check-scenario FILE [--json]`: validates a scenario and everything it names, starts nothing.
@@ -54,9 +64,17 @@ int checkScenario(int argc, char** argv) {
     scenario.profiles = services::activateRunProfiles(cli.get("config-dir"), scenario, cli.getAll("profile"));
     config::activeProfiles().check(cli.get("config-dir"));
     const auto robot = model::loadRobotDescription(cli.get("config-dir") + "/robot.yaml");
-    sim::loadTerrain(cli.get("config-dir") + "/terrain/" + scenario.terrain + ".yaml");
-    sim::loadSimOptions(cli.get("config-dir") + "/sim.yaml");
-    (void)robot;
+    const auto terrain = sim::loadTerrain(cli.get("config-dir") + "/terrain/" + scenario.terrain + ".yaml");
+    const auto options = sim::loadSimOptions(cli.get("config-dir") + "/sim.yaml");
+    services::checkScenarioLimits(scenario, robot, cli.get("config-dir") + "/planner.yaml");
+    // And the initial pose exactly as mft-sim will build it, on this terrain.
+    try {
+      sim::Simulator simulator(robot, options, terrain);
+      simulator.standingConfiguration(initialPose(scenario));
+    } catch (const std::invalid_argument& e) {
+      throw config::ConfigError(scenario.source_file + ": initial_base_height_m: the initial pose cannot be built on terrain '" +
+                                scenario.terrain + "': " + e.what());
+    }
     if (cli.isSet("json")) std::printf("%s\n", scenario.toJson().c_str());
     else std::printf("%s: scenario '%s' is valid (%.3f s, controller %s)\n", scenario.source_file.c_str(),
                      scenario.name.c_str(), scenario.duration_s, scenario.controller.c_str());
@@ -77,7 +95,7 @@ double commandedHeight(const services::Scenario& s, double t) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--check-scenario" || std::string(argv[i]).rfind("--check-scenario=", 0) == 0)
       return checkScenario(argc, argv);
@@ -114,11 +132,11 @@ int main(int argc, char** argv) {
   }
   if (ctx.checkOnly()) return ctx.reportConfigOk();
   sim::Simulator simulator(ctx.robot(), options, terrain);
-  sim::StandingPose pose;
-  pose.base_height_m = scenario.initial_base_height_m;
-  // The scenario's initial stance width, right foot ahead (0: both feet under the hip axis).
-  pose.foot_offset_x_m = {0.5 * scenario.initial_stance_width_m, -0.5 * scenario.initial_stance_width_m};
-  simulator.reset(pose);
+  try {
+    simulator.reset(initialPose(scenario));
+  } catch (const std::invalid_argument& e) {
+    cli.fail(scenario.source_file + ": the initial pose cannot be built: " + e.what());
+  }
   // Pushes at a time go to the simulator now; a push at a lift-off is armed only from its time on (the
   // simulator triggers at the next lift-off after it is scheduled).
   std::vector<std::pair<double, sim::ImpulseSpec>> armed_pushes;
@@ -606,4 +624,9 @@ int main(int argc, char** argv) {
                    ", \"sim_wakeup_late_us\": " + wakeup_late_us.json() + ", \"sim_stalls\": " +
                    std::to_string(sim_stalls) + ", \"damping_onset_sim_late_ms\": " + onset_json + probe_json + "}");
   return exit_code;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-sim", [&] { return toolMain(argc, argv); });
 }

@@ -20,6 +20,7 @@
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "wbc/whole_body_controller.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 
@@ -56,7 +57,7 @@ void toMsg(const wbc::WbcDiagnostics& d, std::uint64_t stamp_ns, msg::WbcDiagnos
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli("mft-wbc", "Whole-body controller service: RobotState + Reference -> JointCommand.");
   services::ServiceContext::declareOptions(cli);
   cli.option("dump-qp", "write the QP of the ticks in --dump-ticks to this folder (WBCQP v1 format)");
@@ -193,4 +194,9 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
   ctx.writeSummary(std::string(buf) + "\"solve_time_us\": " + solve_us.json() + ", \"tick_time_us\": " + tick_us.json() + "}");
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-wbc", [&] { return toolMain(argc, argv); });
 }

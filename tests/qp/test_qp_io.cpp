@@ -2,6 +2,7 @@
 // malformed files.
 #include <gtest/gtest.h>
 
+#include <ctime>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -153,4 +154,26 @@ TEST(QpIo, RefusesMalformedFilesNamingThem) {
     EXPECT_NE(std::string(e.what()).find("missing.txt"), std::string::npos);
   }
   EXPECT_THROW(listQpInstanceFiles("/nonexistent/dir"), QpIoError);
+}
+
+// Issue 16, item 8: data a solver cannot treat as a convex QP is refused on reading, and dims are bounded by
+// what the file can hold before anything is allocated for them.
+TEST(QpIo, RefusesAsymmetricOrNonFiniteDataAndImpossibleDims) {
+  const std::string ok = kSmall;
+  auto replace = [&](const std::string& from, const std::string& to) {
+    std::string s = ok;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  const std::string asym = refusal(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 5\n0 1"));
+  EXPECT_NE(asym.find("H is not symmetric: H(1,0) = 0 but H(0,1) = 5"), std::string::npos) << asym;
+  // Within the relative tolerance (1e-9 x max|H|) is symmetric: rounding of a dumped H must pass.
+  EXPECT_NO_THROW(parseQpInstance(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 1e-12\n0 1"), "ok"));
+  EXPECT_NE(refusal(replace("g 2\n1 -1", "g 2\ninf -1")).find("g has a non-finite entry"), std::string::npos);
+  EXPECT_NE(refusal(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 0\n0 -inf")).find("H has a non-finite entry"), std::string::npos);
+  EXPECT_NE(refusal(replace("Aeq 1 2\n1 1", "Aeq 1 2\n1 inf")).find("Aeq has a non-finite entry"), std::string::npos);
+  const std::clock_t t0 = std::clock();  // CPU time: allocating 80 GB of H would take seconds, or fail
+  const std::string dims = refusal(replace("dims 2 1 1", "dims 100000 100000 100000"));
+  EXPECT_LT(static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC, 0.1);
+  EXPECT_NE(dims.find("need at least 30000000000 matrix entries, more than the file of"), std::string::npos) << dims;
 }

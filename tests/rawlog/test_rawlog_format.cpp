@@ -2,8 +2,15 @@
 // reassembly bit for bit; the recorder writes ticks in order, drops repeats, counts gaps, splits into
 // self-contained pieces; the reader reports clean, truncated and foreign files as documented.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <sstream>
 
 #include <cmath>
 #include <filesystem>
@@ -291,4 +298,238 @@ TEST(RawlogFormat, KnowsEveryFieldOfEveryTopic) {
   EXPECT_EQ(msg::WbcDiagnosticsPubSubType().m_typeSize, 152u) << "WbcDiagnostics changed: update rawlog_format.cpp";
   EXPECT_EQ(msg::OperatorCommandPubSubType().m_typeSize, 32u) << "OperatorCommand changed: update rawlog_format.cpp";
   EXPECT_EQ(msg::DisturbancePubSubType().m_typeSize, 40u) << "Disturbance changed: update rawlog_format.cpp";
+}
+
+// ------------------------------------------------------------------------------ bad input (issue 16, part 3)
+namespace {
+
+// A small real recording, decompressed: the base for crafted files.
+std::string recordedBytes(const TempDir& dir) {
+  RecorderOptions opt;
+  opt.output = dir.file("base.rawlog");
+  opt.metadata = testMetadata();
+  std::mt19937_64 g(7);
+  {
+    Recorder rec(opt);
+    rec.start();
+    for (std::uint64_t k = 0; k < 20; ++k)
+      for (const auto& m : tickMessages(k, g)) rec.push(m);
+    rec.stop();
+  }
+  std::string raw;
+  gzFile f = gzopen(opt.output.c_str(), "rb");
+  char buf[65536];
+  for (int n; (n = gzread(f, buf, sizeof buf)) > 0;) raw.append(buf, static_cast<std::size_t>(n));
+  gzclose(f);
+  return raw;
+}
+
+void writeGzip(const std::string& path, const std::string& bytes) {
+  gzFile f = gzopen(path.c_str(), "wb6");
+  ASSERT_TRUE(f);
+  ASSERT_EQ(gzwrite(f, bytes.data(), static_cast<unsigned>(bytes.size())), static_cast<int>(bytes.size()));
+  gzclose(f);
+}
+
+void putU32(std::string* bytes, std::size_t at, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) (*bytes)[at + static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xffu);
+}
+std::uint32_t getU32(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(i)])) << (8 * i);
+  return v;
+}
+
+// The metadata comment's text length (right after the class name and the version byte) set to ~4 GiB: a
+// valid gzip whose payload declares a huge object.
+std::string hugeCommentFile(const TempDir& dir) {
+  std::string raw = recordedBytes(dir);
+  const std::string cls = "mrpt::obs::CObservationComment";
+  EXPECT_EQ(raw.compare(1, cls.size(), cls), 0);
+  putU32(&raw, 1 + cls.size() + 1, 0xFFFFFFF0u);
+  const std::string path = dir.file("huge-comment.rawlog");
+  writeGzip(path, raw);
+  return path;
+}
+
+// The AIN_8bits count of the first RawDAQ observation set to ~4 G elements.
+std::string hugeVectorFile(const TempDir& dir) {
+  std::string raw = recordedBytes(dir);
+  const std::string cls = "mrpt::obs::CObservationRawDAQ";
+  const std::size_t at = raw.find(static_cast<char>(0x80 | cls.size()) + cls);
+  EXPECT_NE(at, std::string::npos);
+  std::size_t p = at + 1 + cls.size() + 1;  // header, name, version
+  p += 4 + getU32(raw, p);                  // sensorLabel
+  p += 8 + 8;                               // timestamp, sample_rate
+  EXPECT_EQ(getU32(raw, p), 0u) << "AIN_8bits is empty in mft rawlogs";
+  putU32(&raw, p, 0xFFFFFFF0u);
+  const std::string path = dir.file("huge-vector.rawlog");
+  writeGzip(path, raw);
+  return path;
+}
+
+// Caps this test process's address space at its current size + 1 GiB (soft limit, restored at the end), so
+// that a regression allocating what the file declares fails with bad_alloc instead of eating the machine.
+class AddressSpaceCap {
+ public:
+  AddressSpaceCap() {
+    getrlimit(RLIMIT_AS, &saved_);
+    std::ifstream statm("/proc/self/statm");
+    unsigned long long pages = 0;
+    statm >> pages;
+    rlimit cap = saved_;
+    cap.rlim_cur = pages * static_cast<unsigned long long>(sysconf(_SC_PAGESIZE)) + (1ull << 30);
+    if (saved_.rlim_max != RLIM_INFINITY) cap.rlim_cur = std::min<rlim_t>(cap.rlim_cur, saved_.rlim_max);
+    setrlimit(RLIMIT_AS, &cap);
+  }
+  ~AddressSpaceCap() { setrlimit(RLIMIT_AS, &saved_); }
+
+ private:
+  rlimit saved_{};
+};
+
+// CPU time, not wall time: what "fast" means on a loaded machine (a refusal costs milliseconds of CPU;
+// allocating and zeroing what the file declares, seconds).
+double cpuSecondsSince(std::clock_t t0) { return static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC; }
+double childCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+struct ToolRun {
+  int code = -1;
+  std::string err;
+  double seconds = 0.0;  // CPU
+};
+// Runs a tool of the build with `args`; stderr captured, stdout discarded; a 4 GiB address-space cap.
+ToolRun runTool(const std::string& tool, const std::string& args, const TempDir& dir) {
+  const std::string err = dir.file("stderr.txt");
+  const std::string cmd = "ulimit -v 4194304; " + std::string(MFT_BIN_DIR) + "/" + tool + " " + args + " > /dev/null 2> " + err;
+  const double cpu0 = childCpuSeconds();
+  const int status = std::system(cmd.c_str());
+  ToolRun r;
+  r.seconds = childCpuSeconds() - cpu0;  // CPU seconds of the shell and the tool
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+std::size_t lineCount(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+
+}  // namespace
+
+// Item 6: a declared length is bounded before anything is allocated for it; refused at once, with a message
+// that says what was declared.
+TEST(RawlogBadInput, HugeDeclaredMetadataIsRefusedFastWithoutAllocating) {
+  TempDir dir;
+  const std::string path = hugeCommentFile(dir);
+  AddressSpaceCap cap;
+  const std::clock_t t0 = std::clock();
+  try {
+    RawlogReader r(path);
+    FAIL() << "accepted a file declaring a 4 GiB metadata comment";
+  } catch (const NotMftRawlog& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("declares 4294967280 elements"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'text'"), std::string::npos) << msg;
+  }
+  EXPECT_LT(cpuSecondsSince(t0), 0.5);
+}
+
+TEST(RawlogBadInput, HugeDeclaredObservationEndsTheReadAsCorruptFast) {
+  TempDir dir;
+  const std::string path = hugeVectorFile(dir);
+  AddressSpaceCap cap;
+  const std::clock_t t0 = std::clock();
+  RawlogReader r(path);
+  const auto got = readAll(r);
+  EXPECT_LT(cpuSecondsSince(t0), 0.5);
+  EXPECT_EQ(r.end(), RawlogReader::End::Corrupt) << r.endMessage();
+  EXPECT_NE(r.endMessage().find("declares 4294967280 elements"), std::string::npos) << r.endMessage();
+  EXPECT_NE(r.endMessage().find("AIN_8bits"), std::string::npos) << r.endMessage();
+  EXPECT_TRUE(got.empty()) << "the first observation is the damaged one";
+}
+
+TEST(RawlogBadInput, ExportAndReplayRefuseAHugeDeclaredObjectInWellUnderASecond) {
+  TempDir dir;
+  const std::string path = hugeCommentFile(dir);
+  for (const auto& [tool, args] : std::vector<std::pair<std::string, std::string>>{
+           {"mft-export", path + " --info"}, {"mft-replay", path + " --through-wbc"}}) {
+    const ToolRun r = runTool(tool, args, dir);
+    EXPECT_EQ(r.code, 2) << tool << ": " << r.err;
+    EXPECT_NE(r.err.find("declares 4294967280 elements"), std::string::npos) << tool << ": " << r.err;
+    EXPECT_EQ(lineCount(r.err), 1u) << tool << ": " << r.err;
+    EXPECT_LT(r.seconds, 2.0) << tool << " CPU seconds (process start included)";
+  }
+  const ToolRun r = runTool("mft-export", hugeVectorFile(dir) + " --info", dir);
+  EXPECT_EQ(r.code, 4) << r.err;  // corrupt: exported up to the damage
+  EXPECT_NE(r.err.find("AIN_8bits"), std::string::npos) << r.err;
+  EXPECT_LT(r.seconds, 2.0);
+}
+
+// Item 12: what a file is when it is not a rawlog, instead of "empty file".
+TEST(RawlogBadInput, RefusalsSayWhatTheFileIs) {
+  TempDir dir;
+  const std::string raw = recordedBytes(dir);
+  auto refusal = [](const std::string& path) {
+    try {
+      RawlogReader r(path);
+    } catch (const NotMftRawlog& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  fs::create_directories(dir.file("a-folder"));
+  EXPECT_NE(refusal(dir.file("a-folder")).find("is a directory"), std::string::npos) << refusal(dir.file("a-folder"));
+  // The first 100 bytes of a real recording.
+  {
+    std::ifstream in(dir.file("base.rawlog"), std::ios::binary);
+    std::string head(100, '\0');
+    in.read(head.data(), 100);
+    std::ofstream(dir.file("cut100.rawlog"), std::ios::binary) << head;
+  }
+  const std::string cut = refusal(dir.file("cut100.rawlog"));
+  EXPECT_NE(cut.find("truncated header"), std::string::npos) << cut;
+  EXPECT_EQ(cut.find("empty file"), std::string::npos) << cut;
+  // 100 bytes that are neither gzip nor MRPT.
+  std::ofstream(dir.file("junk.rawlog"), std::ios::binary) << std::string(100, 'x');
+  const std::string junk = refusal(dir.file("junk.rawlog"));
+  EXPECT_NE(junk.find("not an MFT rawlog"), std::string::npos) << junk;
+  std::ofstream(dir.file("empty.rawlog")).close();
+  EXPECT_NE(refusal(dir.file("empty.rawlog")).find("empty file (0 bytes)"), std::string::npos);
+  // The metadata comment cut in the middle (decompressed data ends inside it).
+  writeGzip(dir.file("cut-comment.rawlog"), raw.substr(0, 60));
+  const std::string cut_comment = refusal(dir.file("cut-comment.rawlog"));
+  EXPECT_NE(cut_comment.find("truncated header: the file ends inside the metadata comment"), std::string::npos) << cut_comment;
+  // And the tools say the same, on one line.
+  const ToolRun r = runTool("mft-export", dir.file("a-folder") + " --info", dir);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("is a directory"), std::string::npos) << r.err;
+}
+
+// Item 5: output folders that cannot be folders are an error with one line and exit 2, never an uncaught
+// std::filesystem_error (exit 134).
+TEST(RawlogBadInput, ExportOutputFolderErrorsAreOneLineAndExit2) {
+  TempDir dir;
+  recordedBytes(dir);
+  const std::string rawlog = dir.file("base.rawlog");
+  std::ofstream(dir.file("existing.txt")) << "not a folder\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--csv " + dir.file("existing.txt"), "exists and is not a directory"},
+      {"--csv /proc/mft-no-such-dir", "cannot create the folder /proc/mft-no-such-dir"},
+      {"--plot " + dir.file("existing.txt"), "exists and is not a directory"},
+      {"--csv " + dir.file("existing.txt") + "/sub", "cannot create the folder"},
+  };
+  for (const auto& [args, expect] : cases) {
+    const ToolRun r = runTool("mft-export", rawlog + " " + args, dir);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(expect), std::string::npos) << args << ": " << r.err;
+    EXPECT_EQ(r.err.find("terminate"), std::string::npos) << args << ": " << r.err;
+    EXPECT_LE(lineCount(r.err), 2u) << args << ": " << r.err;  // the error and CommandLine's "(see --help)" hint
+  }
+  EXPECT_EQ(fs::file_size(dir.file("existing.txt")), 13u) << "the existing file was touched";
 }

@@ -10,6 +10,7 @@
 
 #include "model/config/profiles.hpp"
 #include "wbc/reference_from_plan.hpp"
+#include "model/config/tool_io.hpp"
 
 namespace mft::closedloop {
 namespace {
@@ -228,6 +229,7 @@ void ClosedLoop::accumulate() {
   sum_est_p2_ += ep * ep;
   sum_est_vx2_ += ev * ev;
   const double n = static_cast<double>(n_window_);
+  s.window_samples = n_window_;
   s.window_s = t - window_t0_;
   s.mean_base_z = sum_z_ / n;
   s.rms_base_z_error = std::sqrt(sum_ez2_ / n);
@@ -263,17 +265,21 @@ std::string ClosedLoop::recoveryJson() const {
 }
 
 std::string RunSummary::toJson() const {
+  // Window figures are null when the window holds no sample (the run ended before it began): their
+  // initial values are placeholders, not measurements.
+  auto stat = [&](double v) { return window_samples ? config::jsonNumber(v, 6) : std::string("null"); };
   std::ostringstream o;
   o.precision(6);
-  o << "{\"fell\": " << (fell ? "true" : "false") << ", \"fall_time_s\": " << fall_time_s << ", \"fall_reason\": \""
-    << fall_reason << "\", \"ticks\": " << ticks << ", \"sim_time_s\": " << sim_time_s
-    << ", \"wall_time_s\": " << wall_time_s << ", \"window_s\": " << window_s << ", \"mean_base_z_m\": " << mean_base_z
-    << ", \"min_base_z_m\": " << min_base_z << ", \"max_base_z_m\": " << max_base_z
-    << ", \"rms_base_z_error_m\": " << rms_base_z_error << ", \"max_abs_base_z_error_m\": " << max_abs_base_z_error
-    << ", \"rms_pitch_rad\": " << rms_pitch << ", \"max_abs_pitch_rad\": " << max_abs_pitch
-    << ", \"average_speed_mps\": " << average_speed << ", \"estimator_rms_error\": {\"z_m\": " << est_rms_z
-    << ", \"pitch_rad\": " << est_rms_pitch << ", \"vx_mps\": " << est_rms_vx << "}"
-    << ", \"max_mft_violation\": " << max_mft_violation << ", \"min_lti\": " << min_lti << ", \"steps\": " << steps
+  o << "{\"fell\": " << (fell ? "true" : "false") << ", \"fall_time_s\": " << fall_time_s << ", \"fall_reason\": "
+    << config::jsonString(fall_reason) << ", \"ticks\": " << ticks << ", \"sim_time_s\": " << sim_time_s
+    << ", \"wall_time_s\": " << wall_time_s << ", \"window_s\": " << window_s
+    << ", \"window_samples\": " << window_samples << ", \"mean_base_z_m\": " << stat(mean_base_z)
+    << ", \"min_base_z_m\": " << stat(min_base_z) << ", \"max_base_z_m\": " << stat(max_base_z)
+    << ", \"rms_base_z_error_m\": " << stat(rms_base_z_error) << ", \"max_abs_base_z_error_m\": " << stat(max_abs_base_z_error)
+    << ", \"rms_pitch_rad\": " << stat(rms_pitch) << ", \"max_abs_pitch_rad\": " << stat(max_abs_pitch)
+    << ", \"average_speed_mps\": " << stat(average_speed) << ", \"estimator_rms_error\": {\"z_m\": " << stat(est_rms_z)
+    << ", \"pitch_rad\": " << stat(est_rms_pitch) << ", \"vx_mps\": " << stat(est_rms_vx) << "}"
+    << ", \"max_mft_violation\": " << stat(max_mft_violation) << ", \"min_lti\": " << stat(min_lti) << ", \"steps\": " << steps
     << ", \"touchdowns\": {\"early\": " << early_touchdowns << ", \"late\": " << late_touchdowns
     << ", \"forced\": " << forced_touchdowns << "}, \"non_optimal_solves\": " << non_optimal_solves
     << ", \"safety_events\": " << safety_events << ", \"torque_clamped_ticks\": " << torque_clamped_ticks

@@ -64,6 +64,7 @@ struct RunSummary {
   std::uint64_t ticks = 0;
   double sim_time_s = 0.0, wall_time_s = 0.0;
   double window_s = 0.0;               // length of the statistics window covered so far
+  std::uint64_t window_samples = 0;    // ticks in it; 0: the figures below are undefined (printed n/a, JSON null)
   double mean_base_z = 0.0;            // [m]
   double rms_base_z_error = 0.0;       // vs the commanded height [m]
   double max_abs_base_z_error = 0.0;

@@ -10,12 +10,14 @@
 #include <fstream>
 
 #include "model/config/strict_yaml.hpp"
+#include "services/runtime/scenario_limits.hpp"
 #include "services/runtime/process.hpp"
 #include "tools/closedloop/closed_loop.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli(
       "mft-closedloop",
       "Run sim -> estimator -> planner -> WBC in one process on the sim clock, with the stack's configs, reference\n"
@@ -103,6 +105,14 @@ int main(int argc, char** argv) {
   options.stop_at_fall = !cli.isSet("continue-after-fall");
   options.stats_from_s = cli.getDouble("stats-from", 0.0, 3600.0);
   if (cli.isSet("stance-width")) scenario.initial_stance_width_m = cli.getDouble("stance-width", 0.0, 0.4);
+  // As the stack does (mft-sim --check-scenario): the start pose in the legs' reach, the commands inside
+  // what the planner accepts.
+  try {
+    services::checkScenarioLimits(scenario, configs.robot,
+                                  planner::commandLimits(configs.robot, configs.planner.command, configs.planner.source_file));
+  } catch (const config::ConfigError& e) {
+    cli.fail(e.what());
+  }
   std::unique_ptr<closedloop::ClosedLoop> loop;
   try {
     loop = std::make_unique<closedloop::ClosedLoop>(configs, scenario, options);
@@ -159,17 +169,30 @@ int main(int argc, char** argv) {
                 scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",
                 scenario.profiles.empty() ? "" : services::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
                 s.fell ? ": " : "", s.fall_reason.c_str());
-    std::printf("  window %.1f s: base z mean %.4f m [%.4f, %.4f], rms error %.4f m; pitch rms %.4f max %.4f rad\n",
-                s.window_s, s.mean_base_z, s.min_base_z, s.max_base_z, s.rms_base_z_error, s.rms_pitch,
-                s.max_abs_pitch);
-    std::printf("  average speed %.4f m/s; steps %llu (early %llu, late %llu, forced %llu); estimator rms z %.4f m, "
-                "pitch %.4f rad, vx %.4f m/s\n",
-                s.average_speed, static_cast<unsigned long long>(s.steps),
+    // An empty statistics window (the run ended before --stats-from) has no figures: n/a, not placeholders.
+    const bool have = s.window_samples > 0;
+    auto stat = [&](double v, int decimals) {
+      char buf[32];
+      if (!have) return std::string("n/a");
+      std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+      return std::string(buf);
+    };
+    if (!have)
+      std::printf("  window empty: the run ended before the statistics window began at %.1f s (--stats-from): "
+                  "no window figures\n", options.stats_from_s);
+    std::printf("  window %.1f s: base z mean %s m [%s, %s], rms error %s m; pitch rms %s max %s rad\n", s.window_s,
+                stat(s.mean_base_z, 4).c_str(), stat(s.min_base_z, 4).c_str(), stat(s.max_base_z, 4).c_str(),
+                stat(s.rms_base_z_error, 4).c_str(), stat(s.rms_pitch, 4).c_str(), stat(s.max_abs_pitch, 4).c_str());
+    std::printf("  average speed %s m/s; steps %llu (early %llu, late %llu, forced %llu); estimator rms z %s m, "
+                "pitch %s rad, vx %s m/s\n",
+                stat(s.average_speed, 4).c_str(), static_cast<unsigned long long>(s.steps),
                 static_cast<unsigned long long>(s.early_touchdowns), static_cast<unsigned long long>(s.late_touchdowns),
-                static_cast<unsigned long long>(s.forced_touchdowns), s.est_rms_z, s.est_rms_pitch, s.est_rms_vx);
-    std::printf("  max MFT violation %.4f rad, min LTI %.3f; non-optimal solves %llu, torque clamped %llu; "
+                static_cast<unsigned long long>(s.forced_touchdowns), stat(s.est_rms_z, 4).c_str(),
+                stat(s.est_rms_pitch, 4).c_str(), stat(s.est_rms_vx, 4).c_str());
+    std::printf("  max MFT violation %s rad, min LTI %s; non-optimal solves %llu, torque clamped %llu; "
                 "%.1fx real time\n",
-                s.max_mft_violation, s.min_lti, static_cast<unsigned long long>(s.non_optimal_solves),
+                stat(s.max_mft_violation, 4).c_str(), stat(s.min_lti, 3).c_str(),
+                static_cast<unsigned long long>(s.non_optimal_solves),
                 static_cast<unsigned long long>(s.torque_clamped_ticks), s.sim_time_s / std::max(s.wall_time_s, 1e-9));
     if (!scenario.pushes.empty()) {
       const auto v = loop->recoveryVerdict();
@@ -178,4 +201,9 @@ int main(int argc, char** argv) {
     }
   }
   return s.fell ? 1 : 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-closedloop", [&] { return toolMain(argc, argv); });
 }

@@ -4,8 +4,9 @@
 
 #include <cstring>
 #include <iostream>
+#include "model/config/tool_io.hpp"
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::cout << "mft-bench: all benchmarks of mft-wbc (Google Benchmark).\n"
@@ -23,4 +24,9 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-bench", [&] { return toolMain(argc, argv); });
 }

@@ -20,6 +20,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -63,7 +64,7 @@ struct Verdict {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli(
       "mft-cmd",
       "Send an operator command or a push to a running mft-wbc stack and wait for its verdict.\n"
@@ -264,4 +265,9 @@ int main(int argc, char** argv) {
   } catch (const services::DdsError& e) {
     return finish(kUsage, "error", e.what());
   }
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-cmd", [&] { return toolMain(argc, argv); });
 }

@@ -1,6 +1,8 @@
 // mft-export: an mft rawlog to full-precision CSV (one file per label, named columns, %.17g), a summary of
 // what a file holds (--info), or paper-style figures (--plot: CSV + tools/mft-export/mft-plot.py).
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -8,6 +10,7 @@
 #include <sstream>
 #include <vector>
 
+#include "model/config/tool_io.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/runtime/process.hpp"
 
@@ -27,18 +30,7 @@ std::string takeFile(int* argc, char** argv) {
   return f;
 }
 
-std::string jsonEscape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') {
-      o += "\\n";
-      continue;
-    }
-    o += c;
-  }
-  return o;
-}
+using config::jsonEscape;
 
 struct LabelInfo {
   std::uint64_t count = 0;
@@ -48,9 +40,16 @@ struct LabelInfo {
   std::FILE* csv = nullptr;
 };
 
-}  // namespace
+// An output folder must be a folder (or not exist yet, then it is created); refused before anything is read.
+void prepareOutputDir(const services::CommandLine& cli, const std::string& option, const std::string& dir) {
+  std::error_code ec;
+  const auto st = fs::status(dir, ec);
+  if (fs::exists(st) && !fs::is_directory(st)) cli.fail("--" + option + ": " + dir + " exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) cli.fail("--" + option + ": cannot create the folder " + dir + ": " + ec.message());
+}
 
-int main(int argc, char** argv) {
+int exportMain(int argc, char** argv) {
   std::string file = takeFile(&argc, argv);
   services::CommandLine cli(
       "mft-export FILE",
@@ -96,7 +95,8 @@ int main(int argc, char** argv) {
         only.insert(l);
       }
   }
-  if (!csv_dir.empty()) fs::create_directories(csv_dir);
+  if (cli.isSet("plot")) prepareOutputDir(cli, "plot", cli.get("plot"));
+  if (!csv_dir.empty()) prepareOutputDir(cli, cli.isSet("plot") ? "plot" : "csv", csv_dir);
 
   const auto& specs = rawlog::labels();
   std::vector<LabelInfo> info(specs.size());
@@ -131,8 +131,8 @@ int main(int argc, char** argv) {
         const std::string path = (fs::path(csv_dir) / (spec.label + ".csv")).string();
         in.csv = std::fopen(path.c_str(), "w");
         if (!in.csv) {
-          std::fprintf(stderr, "mft-export: cannot write %s\n", path.c_str());
-          return 1;
+          std::fprintf(stderr, "mft-export: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
+          return kExitBadInput;
         }
         std::fputs("stamp_ns,time_s", in.csv);
         for (const auto& c : spec.columns) std::fprintf(in.csv, ",%s", c.c_str());
@@ -143,8 +143,16 @@ int main(int argc, char** argv) {
       std::fputc('\n', in.csv);
     }
   }
+  bool csv_write_failed = false;  // a full disk shows only here: say so rather than leave short CSV files
   for (auto& in : info)
-    if (in.csv) std::fclose(in.csv);
+    if (in.csv) {
+      const bool failed = std::ferror(in.csv) != 0;
+      csv_write_failed = (std::fclose(in.csv) != 0) || failed || csv_write_failed;
+    }
+  if (csv_write_failed) {
+    std::fprintf(stderr, "mft-export: writing the CSV files in %s failed (disk full?)\n", csv_dir.c_str());
+    return kExitBadInput;
+  }
 
   const bool json = cli.isSet("json");
   if (json) {
@@ -167,8 +175,9 @@ int main(int argc, char** argv) {
                 "\"time_base_unix_ns\": %lld, \"first_unix_s\": %.6f, \"last_unix_s\": %.6f, \"file_bytes\": %llu, "
                 "\"objects\": %llu, \"unknown_objects\": %llu, \"labels\": {%s}, \"end\": \"%s\", "
                 "\"end_message\": \"%s\", \"csv_dir\": \"%s\"}\n",
-                jsonEscape(file).c_str(), md.format.c_str(), md.schema_version, md.scenario_name.c_str(), md.mode.c_str(),
-                md.controller.c_str(), md.created_utc.c_str(), md.robot_checksum.c_str(), md.piece,
+                jsonEscape(file).c_str(), jsonEscape(md.format).c_str(), md.schema_version, jsonEscape(md.scenario_name).c_str(),
+                jsonEscape(md.mode).c_str(), jsonEscape(md.controller).c_str(), jsonEscape(md.created_utc).c_str(),
+                jsonEscape(md.robot_checksum).c_str(), md.piece,
                 static_cast<long long>(md.time_base_unix_ns), first_unix_ns < 0 ? 0.0 : static_cast<double>(first_unix_ns) * 1e-9,
                 static_cast<double>(last_unix_ns) * 1e-9, static_cast<unsigned long long>(reader->fileSize()),
                 static_cast<unsigned long long>(reader->objects()), static_cast<unsigned long long>(unknown),
@@ -208,4 +217,10 @@ int main(int argc, char** argv) {
     return kExitCorrupt;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return config::guardedMain("mft-export", [&] { return exportMain(argc, argv); });
 }

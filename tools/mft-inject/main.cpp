@@ -15,6 +15,8 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <map>
@@ -31,6 +33,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -295,18 +298,11 @@ void withTopicType(const std::string& topic, F&& f) {
   else if (topic == "Disturbance") f(msg::Disturbance{}, msg::DisturbancePubSubType{});
 }
 
-std::string jsonString(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    o += (c == '\n') ? ' ' : c;
-  }
-  return o + "\"";
-}
+using mft::config::jsonString;
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   services::CommandLine cli(
       "mft-inject",
       "Test participant for the security tests and the fault matrix (docs/security.md, docs/faults.md).\n"
@@ -368,6 +364,9 @@ int main(int argc, char** argv) {
   std::unique_ptr<services::DdsParticipant> participant;
   int exit_code = 0;
   double matched_after_s = -1.0, writers_matched_after_s = -1.0;
+  // A profile file that cannot be read is a usage error (exit 2), not a participant the stack refused (4).
+  if (!std::ifstream(cli.get("profiles")).good() || std::filesystem::is_directory(cli.get("profiles")))
+    cli.fail("--profiles: cannot read the DDS profile file " + cli.get("profiles"));
   try {
     participant = std::make_unique<services::DdsParticipant>(domain, cli.get("profiles"), "mft-inject", security);
   } catch (const services::DdsError& e) {
@@ -515,4 +514,9 @@ int main(int argc, char** argv) {
   publisher.reset();
   participant.reset();
   return exit_code;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-inject", [&] { return toolMain(argc, argv); });
 }

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "qp_commands.hpp"
+#include "model/config/tool_io.hpp"
 
 namespace {
 
@@ -20,7 +21,8 @@ const char* kUsage =
     "  mft-qp solve FILE [--json]\n"
     "      Solves one instance and prints status, objective, accuracy, KKT residuals and the active set.\n"
     "  mft-qp --help\n"
-    "Exit codes: 0 success, 1 a solve did not reach Optimal, 2 bad arguments or unreadable input.\n";
+    "Exit codes: 0 success, 1 a solve did not reach Optimal or its answer failed the KKT check (status\n"
+    "\"unverified\"), 2 bad arguments or unreadable input (also a non-finite or asymmetric H).\n";
 
 int usageError(const std::string& message) {
   std::cerr << "mft-qp: " << message << "\n(see mft-qp --help)\n";
@@ -37,7 +39,7 @@ bool parseInt(const char* s, int* out) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   if (argc < 2) return usageError("missing command");
   const std::string cmd = argv[1];
   if (cmd == "--help" || cmd == "-h" || cmd == "help") {
@@ -100,4 +102,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   return usageError("unknown command '" + cmd + "'");
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-qp", [&] { return toolMain(argc, argv); });
 }

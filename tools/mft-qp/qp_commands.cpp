@@ -14,6 +14,7 @@
 #include <sstream>
 #include <vector>
 
+#include "model/config/tool_io.hpp"
 #include "wbc/qp/qp_io.hpp"
 #include "wbc/qp/qp_kkt.hpp"
 #include "wbc/qp/qp_solver.hpp"
@@ -64,6 +65,38 @@ Accuracy checkSolution(const QpInstance& inst, const QpSolution& s) {
 
 // The run of an instance named <run>_<tick> (docs/qp-instances.md): the name without its last "_<suffix>".
 std::string runName(const std::string& name) { return name.substr(0, name.rfind('_')); }
+
+// The solver's "optimal" is reported only when its answer satisfies the KKT conditions (stationarity,
+// primal and dual feasibility, complementarity) within kKktTolerance relative to the data's scale, with a
+// finite x and objective; otherwise the answer is "unverified" and `why` says which condition failed. (An
+// asymmetric H or an overflowing g once came back "optimal" with a stationarity residual of 5 or a NaN
+// objective.)
+constexpr double kKktTolerance = 1e-6;
+bool verifiedOptimal(const qp::QpProblem& p, const QpSolution& s, const qp::KktResiduals& k, std::string* why) {
+  auto inf = [](const auto& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; };
+  char buf[200];
+  if (!s.x.allFinite() || !std::isfinite(s.objective)) {
+    *why = "x or the objective is not finite";
+    return false;
+  }
+  const double x_scale = 1.0 + inf(s.x);
+  const double y_scale = 1.0 + std::max({inf(s.y_eq), inf(s.y_bounds), inf(s.y_rows)});
+  const Eigen::VectorXd hx = p.H * s.x;
+  const struct {
+    const char* name;
+    double residual, scale;
+  } checks[] = {{"stationarity", k.stationarity, 1.0 + std::max(inf(hx), inf(p.g))},
+                {"primal feasibility", k.primal, x_scale + inf(p.Aeq * s.x) + inf(p.Ain * s.x)},
+                {"dual feasibility", k.dual, y_scale},
+                {"complementarity", k.complementarity, y_scale * x_scale}};
+  for (const auto& c : checks)
+    if (!(c.residual <= kKktTolerance * c.scale)) {
+      std::snprintf(buf, sizeof buf, "%s residual %.3g > %.0e x scale %.3g", c.name, c.residual, kKktTolerance, c.scale);
+      *why = buf;
+      return false;
+    }
+  return true;
+}
 
 std::vector<QpInstance> loadFolder(const std::string& dir) {
   const std::vector<std::string> files = qp::listQpInstanceFiles(dir);
@@ -118,15 +151,7 @@ std::string numExact(double v) {
   return buf;
 }
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out + "\"";
-}
+using config::jsonString;
 
 }  // namespace
 
@@ -163,9 +188,15 @@ int runBench(const BenchOptions& o) {
       fallbacks += solver.lastSolveFellBack() ? 1 : 0;
       iterations_sum += sol.iterations;
       iterations_max = std::max(iterations_max, sol.iterations);
+      std::string why;
       if (st != QpStatus::Optimal) {
         ++failures;
         if (!o.json) std::cerr << instances[k].name << ": " << qp::toString(st) << "\n";
+        continue;
+      }
+      if (!verifiedOptimal(instances[k].problem, sol, qp::kktResiduals(instances[k].problem, sol), &why)) {
+        ++failures;
+        if (!o.json) std::cerr << instances[k].name << ": unverified: " << why << "\n";
         continue;
       }
       const Accuracy a = checkSolution(instances[k], sol);
@@ -222,12 +253,17 @@ int runSolve(const SolveOptions& o) {
   const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
   const qp::KktResiduals kkt = qp::kktResiduals(p, sol);
   const Accuracy a = checkSolution(inst, sol);
+  std::string why;
+  const bool optimal = st == QpStatus::Optimal && verifiedOptimal(p, sol, kkt, &why);
+  // "unverified": the solver claimed optimal but its answer fails the KKT check.
+  const std::string status = st == QpStatus::Optimal && !optimal ? "unverified" : qp::toString(st);
   std::ostringstream active;
   for (int i = 0; i < p.n + p.nin; ++i)
     if (sol.active[i]) active << (active.tellp() ? " " : "") << (i < p.n ? "x" : "row") << (i < p.n ? i : i - p.n) << (sol.active[i] > 0 ? "+" : "-");
   if (o.json) {
     std::cout << "{\"file\": " << jsonString(o.file) << ", \"name\": " << jsonString(inst.name)
-              << ", \"status\": " << jsonString(qp::toString(st)) << ", \"iterations\": " << sol.iterations
+              << ", \"status\": " << jsonString(status) << ", \"unverified_because\": " << (why.empty() ? "null" : jsonString(why))
+              << ", \"iterations\": " << sol.iterations
               << ", \"objective\": " << numExact(sol.objective)
               << ", \"f_ref\": " << (inst.f_ref ? numExact(*inst.f_ref) : "null")
               << ", \"max_x_err\": " << (inst.x_ref ? num(a.x_err) : "null")
@@ -239,7 +275,8 @@ int runSolve(const SolveOptions& o) {
     std::cout << "]}\n";
   } else {
     std::printf("instance        %s (%s)\n", inst.name.c_str(), o.file.c_str());
-    std::printf("status          %s, %d iterations, %.2f us (single cold call)\n", qp::toString(st), sol.iterations, us);
+    std::printf("status          %s, %d iterations, %.2f us (single cold call)\n", status.c_str(), sol.iterations, us);
+    if (!why.empty()) std::printf("not optimal     the solver said optimal, but %s\n", why.c_str());
     std::printf("objective       %.17g", sol.objective);
     if (inst.f_ref) std::printf("  (f_ref %.17g)", *inst.f_ref);
     std::printf("\n");
@@ -249,7 +286,7 @@ int runSolve(const SolveOptions& o) {
     std::printf("active          %s\n", active.str().c_str());
     if (inst.active_ref) std::printf("vs active_ref   %d entries differ (%d not explained by degeneracy)\n", a.mismatched, a.strict_mismatched);
   }
-  return st == QpStatus::Optimal ? 0 : 1;
+  return optimal ? 0 : 1;
 }
 
 }  // namespace mft::tools

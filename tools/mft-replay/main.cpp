@@ -22,6 +22,7 @@
 #include "services/runtime/topic_io.hpp"
 #include "wbc/wbc_config.hpp"
 #include "wbc/whole_body_controller.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -41,18 +42,7 @@ std::string takeFile(int* argc, char** argv) {
   return f;
 }
 
-std::string jsonEscape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (c == '\n') {
-      o += "\\n";
-      continue;
-    }
-    o += c;
-  }
-  return o;
-}
+using config::jsonEscape;
 
 // ------------------------------------------------------------------------------------------ --through-wbc
 int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
@@ -291,7 +281,7 @@ class ReadAhead {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   std::string file = takeFile(&argc, argv);
   services::CommandLine cli(
       "mft-replay FILE",
@@ -437,4 +427,9 @@ int main(int argc, char** argv) {
     return kExitCorrupt;
   }
   return 0;
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-replay", [&] { return toolMain(argc, argv); });
 }

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <string>
 
+#include "model/config/tool_io.hpp"
+
 namespace mft::tools {
 
 inline std::string jsonNumber(double v) {
@@ -13,19 +15,7 @@ inline std::string jsonNumber(double v) {
   return buf;
 }
 
-inline std::string jsonString(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\', o += c;
-    else if (c == '\n') o += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      o += buf;
-    } else o += c;
-  }
-  return o + "\"";
-}
+inline std::string jsonString(const std::string& s) { return config::jsonString(s); }
 
 // Builds "{...}" from key/value pairs already rendered as JSON.
 class JsonObject {

@@ -16,6 +16,7 @@
 #include "model/config/strict_yaml.hpp"
 #include "space_run.hpp"
 #include "stance_table.hpp"
+#include "model/config/tool_io.hpp"
 
 using namespace mft::model;
 using namespace mft::tools;
@@ -226,7 +227,7 @@ int cmdAll(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int toolMain(int argc, char** argv) {
   if (argc < 2) {
     std::cerr << "mft-space: missing command\n" << kUsage;
     return 2;
@@ -254,4 +255,9 @@ int main(int argc, char** argv) {
     std::cerr << "mft-space " << cmd << ": " << e.what() << "\n";
     return 1;
   }
+}
+
+// I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-space", [&] { return toolMain(argc, argv); });
 }

@@ -33,6 +33,7 @@ class Tokens {
     ++count_;
     return text_.substr(start, pos_ - start);
   }
+  std::size_t textSize() const { return text_.size(); }
   long long integer(const char* what) {
     const std::string w = word(what);
     char* end = nullptr;
@@ -136,6 +137,13 @@ QpInstance parseQpInstance(const std::string& text, const std::string& source) {
     } else if (key == "dims") {
       const long long n = t.integer("n"), neq = t.integer("neq"), nin = t.integer("nin");
       if (n < 0 || neq < 0 || nin < 0 || n > 100000 || neq > 100000 || nin > 100000) t.fail("implausible dims");
+      // Bound what the dims make us allocate by what the file can hold: H, Aeq and Ain alone need
+      // (n + neq + nin) n numbers of at least two characters each ("0 ").
+      const double numbers = static_cast<double>(n + neq + nin) * static_cast<double>(n);
+      if (2.0 * numbers > static_cast<double>(t.textSize()))
+        t.fail("dims n " + std::to_string(n) + ", neq " + std::to_string(neq) + ", nin " + std::to_string(nin) +
+               " need at least " + std::to_string(static_cast<long long>(numbers)) +
+               " matrix entries, more than the file of " + std::to_string(t.textSize()) + " bytes can hold");
       p.resize(static_cast<int>(n), static_cast<int>(neq), static_cast<int>(nin));
       have_dims = true;
     } else if (key == "varblock" || key == "rowblock") {
@@ -185,11 +193,45 @@ QpInstance parseQpInstance(const std::string& text, const std::string& source) {
     if (!seen.count(required)) t.fail(std::string("missing record '") + required + "'");
   for (const QpBlock& b : inst.varblocks)
     if (b.first + b.length > p.n) t.fail("varblock '" + b.name + "' exceeds n");
+  checkProblemData(p, source);
   p.dense_block = detectDenseBlock(p.H);
   return inst;
 }
 
+void checkProblemData(const QpProblem& p, const std::string& source) {
+  auto fail = [&](const std::string& what) { throw QpIoError(source + ": " + what); };
+  auto finite = [&](const auto& m, const char* name) {
+    for (Eigen::Index i = 0; i < m.size(); ++i)
+      if (!std::isfinite(m.data()[i])) fail(std::string(name) + " has a non-finite entry (" + std::to_string(m.data()[i]) + ")");
+  };
+  finite(p.H, "H");
+  finite(p.g, "g");
+  finite(p.Aeq, "Aeq");
+  finite(p.beq, "beq");
+  finite(p.Ain, "Ain");
+  const double scale = p.H.size() ? p.H.cwiseAbs().maxCoeff() : 0.0;
+  for (int j = 0; j < p.n; ++j)
+    for (int i = j + 1; i < p.n; ++i) {
+      const double d = std::abs(p.H(i, j) - p.H(j, i));
+      if (d > kSymmetryTolerance * scale) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      "H is not symmetric: H(%d,%d) = %.17g but H(%d,%d) = %.17g (difference %.3g > %.0e x max|H| = %.3g)",
+                      i, j, p.H(i, j), j, i, p.H(j, i), d, kSymmetryTolerance, kSymmetryTolerance * scale);
+        fail(buf);
+      }
+    }
+}
+
 QpInstance readQpInstance(const std::string& path) {
+  std::error_code ec;
+  const auto st = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(st)) throw QpIoError(path + ": is a directory, not a WBCQP file");
+  if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st))
+    throw QpIoError(path + ": not a regular file");
+  if (std::filesystem::exists(st) && std::filesystem::file_size(path, ec) > kMaxFileBytes)
+    throw QpIoError(path + ": " + std::to_string(std::filesystem::file_size(path, ec)) +
+                    " bytes, more than a WBCQP instance can be (" + std::to_string(kMaxFileBytes) + " bytes at most)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw QpIoError(path + ": cannot open file");
   std::ostringstream ss;

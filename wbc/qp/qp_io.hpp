@@ -30,7 +30,14 @@ struct QpInstance {
   std::optional<Eigen::VectorXi> active_ref;  // length n + nin, docs/qp-instances.md#file-format convention
 };
 
+// Reading refuses, besides malformed text: a directory or other non-regular file, a file over kMaxFileBytes,
+// dims that need more numbers than the file holds (nothing is allocated for them), non-finite H, g, Aeq, beq
+// or Ain, and an H that is not symmetric within kSymmetryTolerance x max|H| (a solver uses one triangle).
+constexpr std::size_t kMaxFileBytes = 256u << 20;
+constexpr double kSymmetryTolerance = 1e-9;
 QpInstance readQpInstance(const std::string& path);
+// The data checks of reading, for a problem built otherwise: throws QpIoError naming `source`.
+void checkProblemData(const QpProblem& p, const std::string& source);
 // source names the text in error messages.
 QpInstance parseQpInstance(const std::string& text, const std::string& source);
 std::string formatQpInstance(const QpInstance& instance);

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "model/config/tool_io.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 
@@ -93,7 +94,7 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int toolMain(int argc, char** argv) {
   mft::services::CommandLine cli(
       "mft-participants",
       "Lists the DDS participants on a domain: joins it with the project's participant profile, listens for\n"
@@ -154,4 +155,8 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  return mft::config::guardedMain("mft-participants", [&] { return toolMain(argc, argv); });
 }

@@ -37,7 +37,7 @@ struct WbcWeights {  // paper Table I, plus the qdd regularization that keeps H 
   double slack = 1.0e3;
   double qdd_regularization = 1.0e-3;
   // Not in Table I: base x task, active only when standing in double support (WbcReference::hold_base_x).
-  double base_x = 1.0;
+  double base_x = 100.0;  // config/wbc.yaml: outweighs w_fc m^2 (Table I)
 };
 
 struct WbcGains {

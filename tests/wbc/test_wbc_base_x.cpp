@@ -30,7 +30,7 @@ Outcome solve(WbcVariant v, const model::RobotStateEstimate& st, const WbcRefere
 
 TEST(WbcBaseX, ConfigHasTheStandingTask) {
   const WbcConfig c = loadWbcConfig(std::string(MFT_CONFIG_DIR) + "/wbc.yaml");
-  EXPECT_DOUBLE_EQ(c.weights.base_x, 1.0);
+  EXPECT_DOUBLE_EQ(c.weights.base_x, 100.0);  // config/wbc.yaml: w_fc m^2 / w_x small under Table I's w_fc
   EXPECT_DOUBLE_EQ(c.gains.base_x.kp, 100.0);
   EXPECT_DOUBLE_EQ(c.gains.base_x.kd, 20.0);
   const WbcConfig d;  // struct defaults are the file's values
@@ -56,7 +56,7 @@ TEST(WbcBaseX, StandingDoubleSupportPullsTheBaseBack) {
   for (WbcVariant v : {WbcVariant::Mft, WbcVariant::Sa}) {
     const Outcome on = solve(v, st, ref);
     ASSERT_EQ(on.status, qp::QpStatus::Optimal);
-    EXPECT_DOUBLE_EQ(on.weight, 1.0);
+    EXPECT_DOUBLE_EQ(on.weight, 100.0);
     EXPECT_LT(on.qdd_x, -1.0) << toString(v);
     EXPECT_GT(on.qdd_x, -3.0 - 1e-6) << toString(v);
     // The same without hold_base_x: the task has no weight and nothing pulls x back.

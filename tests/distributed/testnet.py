@@ -32,6 +32,11 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+# A realtime stack under test runs at SCHED_FIFO 80 and delays an `ip`/`tc`/`nft` at normal priority by tens of
+# ms (once 1.2 s) on 2 busy cores, so a fault is applied inside this (SCHED_FIFO 85 where permitted).
+from simlog import fifo_priority as realtime_priority  # noqa: E402
+
 IFACE = "eth0"
 NFT_TABLE = "mft_fault"
 
@@ -81,31 +86,6 @@ def netns_permitted(probe_name=None):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
             return False, f"'{tool}' is not installed"
     return True, ""
-
-
-class realtime_priority:
-    """Runs a block (and the commands it starts) at SCHED_FIFO `priority` where permitted: a realtime stack
-    under test runs at SCHED_FIFO 80 and delays an `ip`/`tc`/`nft` at normal priority by tens of ms (once
-    1.2 s) on 2 busy cores, so a fault would start and end late."""
-
-    def __init__(self, priority=85):
-        self.priority = priority
-        self.saved = None
-
-    def __enter__(self):
-        try:
-            self.saved = (os.sched_getscheduler(0), os.sched_getparam(0))
-            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(self.priority))
-        except (OSError, AttributeError):
-            self.saved = None
-        return self
-
-    def __exit__(self, *exc):
-        if self.saved:
-            try:
-                os.sched_setscheduler(0, *self.saved)
-            except OSError:
-                pass
 
 
 class TestNet:

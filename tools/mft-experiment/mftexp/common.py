@@ -186,6 +186,15 @@ def profile_options(profiles):
     return [a for name in (profiles or []) for a in ("--profile", name)]
 
 
+# (domain, bin dir, config dir, profiles) of every successful run of this process. The supervisor's checks before
+# a run (each service's --check-config and the busy-domain probe, which listens 1 s) cost about 1.2 s, as much as
+# half of a push run; a worker owns its domain, so after one checked run the next ones on the same domain and
+# configuration skip them (mft-supervisor run --checked-before). A stack started by someone else on that domain
+# meanwhile is refused by its own supervisor's probe, which sees ours.
+_CHECKED_SETUPS = set()
+_CHECKED_LOCK = threading.Lock()
+
+
 def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=None, timeout_s=600.0, profiles=()):
     """One lockstep run through the supervisor. Returns (summary dict, wall seconds); raises ExperimentError
     when the stack itself failed (not when the robot fell) and Interrupted when stopping. `profiles` go to
@@ -193,6 +202,10 @@ def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=Non
     argv = [sys.executable, str(SUPERVISOR), "run", str(scenario_path), "--domain", str(domain), "--json",
             "--bin-dir", str(bin_dir), "--config-dir", str(config_dir), "--run-dir", str(run_dir)]
     argv += profile_options(profiles)
+    setup = (int(domain), str(bin_dir), str(config_dir), tuple(profiles or ()))
+    with _CHECKED_LOCK:
+        if setup in _CHECKED_SETUPS:
+            argv.append("--checked-before")
     if record:
         argv += ["--record", str(record), "--overwrite"]  # a retried or resumed run replaces its own recording
     env = dict(os.environ, MFT_RUNS_DIR=str(Path(run_dir).parent))
@@ -217,6 +230,8 @@ def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=Non
     if not summary.get("ok"):
         raise ExperimentError(f"stack failed on {scenario_path}: {summary.get('error') or summary.get('failed')} "
                               f"(logs in {run_dir})")
+    with _CHECKED_LOCK:
+        _CHECKED_SETUPS.add(setup)
     sim = (summary.get("services") or {}).get("mft-sim") or {}
     if "verdict" not in (sim.get("recovery") or {}):
         raise ExperimentError("mft-sim's summary has no 'recovery' section: rebuild mft-sim "

@@ -156,21 +156,23 @@ class ObjectBounds {
       array(what, "AIN_32bits", 4);
       array(what, "AIN_float", 4);
       array(what, "AIN_double", 8);
-      // TODO(issue 16): the fields after AIN_double are not laid out as assumed here in MRPT 2.5.8 (a real
-      // recording read CNTRIN_double as 2.6e9 elements): until that layout is pinned by a test, only the
-      // fields up to AIN_double (the ones mft rawlogs use) are bounded and the end marker is not checked.
-      return;
+      skip(2 + 1);                                  // AIN_channel_count (uint16), AIN_interleaved (bool)
+      array(what, "AOUT_8bits", 1);
+      array(what, "AOUT_16bits", 2);
+      array(what, "AOUT_float", 4);
+      array(what, "AOUT_double", 8);
+      array(what, "DIN", 1);
+      array(what, "DOUT", 1);
+      array(what, "CNTRIN_32bits", 4);
+      array(what, "CNTRIN_double", 8);
     } else if (cls == "mrpt::obs::CObservationIMU" && depth == 0) {
       if (version != 4) refuseVersion();
-      // TODO(issue 16): MRPT 2.5.8 writes the nested CPose3D at serialization version 3, whose layout is not
-      // pinned by a test yet: the IMU's only length (sensorLabel) is left unchecked until it is.
-      return;
       object(depth + 1);                            // sensorPose
       skip(mrpt::obs::COUNT_IMU_DATA_FIELDS * sizeof(bool) + 8 + mrpt::obs::COUNT_IMU_DATA_FIELDS * 8);
       array(what, "sensorLabel", 1);
     } else if (cls == "mrpt::poses::CPose3D" && depth == 1) {
-      if (version != 2) refuseVersion();
-      skip(7 * 8);                                  // x, y, z and the quaternion
+      if (version != 3) refuseVersion();
+      skip(12 * 8);                                 // x, y, z and the 3x3 rotation matrix (MRPT 2.5)
     } else {
       throw Refused{what + ", which an mft rawlog never holds: not read (its lengths cannot be checked)"};
     }

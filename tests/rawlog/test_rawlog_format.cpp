@@ -368,6 +368,34 @@ std::string hugeVectorFile(const TempDir& dir) {
   return path;
 }
 
+// Offset of the element count of `field` in the first object of class `cls` in a recorded rawlog's bytes,
+// walking the layouts MRPT 2.5.8 writes (docs/mrpt.md "What the reader checks").
+std::size_t countOffset(const std::string& raw, const std::string& cls, const std::string& field) {
+  const std::size_t at = raw.find(static_cast<char>(0x80 | cls.size()) + cls);
+  EXPECT_NE(at, std::string::npos) << cls;
+  std::size_t p = at + 1 + cls.size() + 1;  // header, name, version
+  if (cls == "mrpt::obs::CObservationIMU") {
+    const std::string pose = "mrpt::poses::CPose3D";
+    EXPECT_EQ(raw.compare(p + 1, pose.size(), pose), 0);
+    p += 1 + pose.size() + 1 + 12 * 8 + 1;  // sensorPose: header, name, version 3, 12 doubles, end marker
+    p += 31 + 8 + 31 * 8;                   // dataIsPresent, timestamp, rawMeasurements
+    EXPECT_EQ(field, "sensorLabel");
+    return p;
+  }
+  const std::vector<std::pair<std::string, std::size_t>> arrays = {
+      {"sensorLabel", 1}, {"AIN_8bits", 1}, {"AIN_16bits", 2}, {"AIN_32bits", 4}, {"AIN_float", 4},
+      {"AIN_double", 8}, {"AOUT_8bits", 1}, {"AOUT_16bits", 2}, {"AOUT_float", 4}, {"AOUT_double", 8},
+      {"DIN", 1}, {"DOUT", 1}, {"CNTRIN_32bits", 4}, {"CNTRIN_double", 8}};
+  for (const auto& [name, bytes] : arrays) {
+    if (name == field) return p;
+    p += 4 + bytes * getU32(raw, p);
+    if (name == "sensorLabel") p += 8 + 8;  // timestamp, sample_rate
+    if (name == "AIN_double") p += 2 + 1;   // AIN_channel_count, AIN_interleaved
+  }
+  ADD_FAILURE() << "no field " << field;
+  return 0;
+}
+
 // Caps this test process's address space at its current size + 1 GiB (soft limit, restored at the end), so
 // that a regression allocating what the file declares fails with bad_alloc instead of eating the machine.
 class AddressSpaceCap {
@@ -452,6 +480,49 @@ TEST(RawlogBadInput, HugeDeclaredObservationEndsTheReadAsCorruptFast) {
   EXPECT_NE(r.endMessage().find("declares 4294967280 elements"), std::string::npos) << r.endMessage();
   EXPECT_NE(r.endMessage().find("AIN_8bits"), std::string::npos) << r.endMessage();
   EXPECT_TRUE(got.empty()) << "the first observation is the damaged one";
+}
+
+// Every length field of every object mft-record writes is bounded, the last ones included (the IMU's label
+// after its nested pose; the RawDAQ's counter channels after the fields mft rawlogs fill).
+TEST(RawlogBadInput, EveryDeclaredLengthOfEveryRecordedClassIsBounded) {
+  TempDir dir;
+  const std::string raw = recordedBytes(dir);
+  for (const auto& [cls, field] : std::vector<std::pair<std::string, std::string>>{
+           {"mrpt::obs::CObservationIMU", "sensorLabel"},
+           {"mrpt::obs::CObservationRawDAQ", "AOUT_double"},
+           {"mrpt::obs::CObservationRawDAQ", "DOUT"},
+           {"mrpt::obs::CObservationRawDAQ", "CNTRIN_double"}}) {
+    std::string bad = raw;
+    const std::size_t at = countOffset(bad, cls, field);
+    ASSERT_GT(at, 0u);
+    putU32(&bad, at, 0xFFFFFFF0u);
+    const std::string path = dir.file("huge-" + field + ".rawlog");
+    writeGzip(path, bad);
+    AddressSpaceCap cap;
+    const std::clock_t t0 = std::clock();
+    RawlogReader r(path);
+    const auto got = readAll(r);
+    EXPECT_LT(cpuSecondsSince(t0), 0.5) << field;
+    EXPECT_EQ(r.end(), RawlogReader::End::Corrupt) << field << ": " << r.endMessage();
+    EXPECT_NE(r.endMessage().find("declares 4294967280 elements"), std::string::npos) << r.endMessage();
+    EXPECT_NE(r.endMessage().find("'" + field + "'"), std::string::npos) << r.endMessage();
+  }
+}
+
+// The walk ends exactly at each object's end marker: a damaged marker after the last field is found.
+TEST(RawlogBadInput, AMissingEndMarkerAfterTheLastFieldIsCorrupt) {
+  TempDir dir;
+  std::string raw = recordedBytes(dir);
+  const std::size_t at = countOffset(raw, "mrpt::obs::CObservationRawDAQ", "CNTRIN_double");
+  const std::size_t end = at + 4 + 8 * getU32(raw, at);
+  ASSERT_EQ(static_cast<unsigned char>(raw[end]), 0x88u) << "the layout walked here is MRPT's";
+  raw[end] = 0x55;
+  const std::string path = dir.file("no-end-marker.rawlog");
+  writeGzip(path, raw);
+  RawlogReader r(path);
+  readAll(r);
+  EXPECT_EQ(r.end(), RawlogReader::End::Corrupt) << r.endMessage();
+  EXPECT_NE(r.endMessage().find("end marker"), std::string::npos) << r.endMessage();
 }
 
 TEST(RawlogBadInput, ExportAndReplayRefuseAHugeDeclaredObjectInWellUnderASecond) {

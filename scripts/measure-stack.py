@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Loop benchmark of the multi-process stack (README "Loop benchmark").
+"""Loop benchmark of the multi-process stack (docs/benchmarks.md "Loop benchmark").
 
 Measures, through services/mft-supervisor and the real services:
   * lockstep speed: wall time of the simulator's loop for a 10 s step-in-place run, as a real-time factor;

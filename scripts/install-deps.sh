@@ -7,6 +7,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libyaml-cpp-dev libode-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
+  cyclonedds-dev cyclonedds-tools
   libmrpt-obs-dev libmrpt-io-dev mrpt-apps
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-yaml python3-matplotlib

@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+"""A second DDS vendor on the stack (docs/interop.md): mft-cyclone, built with Eclipse Cyclone DDS from the
+project's IDL, reads SensorData, JointCommand and Reference from a running Fast DDS stack (values sane, ticks
+increasing) and sends an OperatorCommand that the stack obeys; a height out of reach is rejected with the
+planner's reason. One realtime stack on DDS domain 226, started through the supervisor and stopped by it (by
+pid) even when a test fails. Needs MFT_BIN_DIR (set by CTest)."""
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parent.parent.parent
+SUPERVISOR = REPO / "services" / "mft-supervisor"
+BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+DOMAIN = 226
+ROBOT = yaml.safe_load((REPO / "config" / "robot.yaml").read_text())
+PEAK_TORQUE = ROBOT["actuator"]["gear_ratio"] * ROBOT["actuator"]["motor_peak_torque_Nm"]
+SCENARIO_HEIGHT = 0.42  # step-in-place.yaml
+NEW_HEIGHT = 0.40
+
+
+def cyclone(*args, timeout=90):
+    """Runs mft-cyclone with --json; returns (exit code, parsed JSON or None, stderr)."""
+    p = subprocess.run([str(BIN / "mft-cyclone")] + [str(a) for a in args] + ["--json"], capture_output=True,
+                       text=True, timeout=timeout)
+    try:
+        return p.returncode, json.loads(p.stdout), p.stderr
+    except ValueError:
+        return p.returncode, None, p.stderr
+
+
+class CycloneOnTheStack(unittest.TestCase):
+    """The tests run in name order against one stack; the last one stops it and reads the planner's counts."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = Path(tempfile.mkdtemp(prefix="mft-interop-test-"))
+        cls.env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
+        cls.run_dir = cls.tmp / "run"
+        p = subprocess.run([sys.executable, str(SUPERVISOR), "up", str(REPO / "config" / "scenarios" / "step-in-place.yaml"),
+                            "--domain", str(DOMAIN), "--mode", "realtime", "--run-dir", str(cls.run_dir), "--bin-dir",
+                            str(BIN)], env=cls.env, capture_output=True, text=True, timeout=180)
+        cls.up_error = None if p.returncode == 0 else f"supervisor up failed ({p.returncode}): {p.stderr[-2000:]}"
+
+    @classmethod
+    def tearDownClass(cls):
+        subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN)], env=cls.env,
+                       capture_output=True, timeout=60)
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def setUp(self):
+        if self.up_error:
+            self.fail(self.up_error)
+
+    def listen(self, samples):
+        code, r, err = cyclone("listen", "--domain", DOMAIN, "--min-samples", samples, "--seconds", 60)
+        self.assertEqual(code, 0, err)
+        self.assertIsNotNone(r, err)
+        for name, t in r["topics"].items():
+            self.assertGreaterEqual(t["samples"], samples, (name, t))
+            self.assertEqual(t["tick_decreases"], 0, (name, t))
+            self.assertEqual(t["nonfinite"], 0, (name, t))
+            # 1 kHz ticks: never more samples than ticks, and best effort on loopback loses few of them.
+            span = t["last_tick"] - t["first_tick"] + 1
+            self.assertLessEqual(t["samples"], span, (name, t))
+            self.assertGreaterEqual(t["samples"], 0.8 * span, (name, t))
+        return r["topics"]
+
+    def test_1_cyclone_reads_the_control_topics(self):
+        topics = self.listen(1000)
+        joints = topics["SensorData"]
+        self.assertGreater(joints["max"] - joints["min"], 0.1, joints)  # the hips move: the robot steps
+        self.assertLessEqual(max(abs(joints["min"]), abs(joints["max"])), math.pi, joints)
+        tau = topics["JointCommand"]
+        self.assertLessEqual(max(abs(tau["min"]), abs(tau["max"])), PEAK_TORQUE + 1e-9, tau)
+        self.assertGreater(tau["max"], 1.0, tau)  # holding the robot up takes torque
+        ref = topics["Reference"]
+        self.assertAlmostEqual(ref["min"], SCENARIO_HEIGHT, delta=1e-9)
+        self.assertAlmostEqual(ref["max"], SCENARIO_HEIGHT, delta=1e-9)
+
+    def test_2_an_operator_command_from_cyclone_is_obeyed(self):
+        code, r, err = cyclone("command", "--domain", DOMAIN, "--mode", "step_in_place", "--height", NEW_HEIGHT,
+                               "--wait", 30)
+        self.assertIsNotNone(r, err)
+        self.assertEqual((code, r["result"]), (0, "applied"), (r, err))
+        self.assertIn("height 0.400 m", r["reason"])
+        applied_tick = r["tick"]
+        # The planner's Reference follows from the applied tick on (bounded wait for samples past it).
+        deadline = time.monotonic() + 60
+        while True:
+            topics = self.listen(200)
+            ref = topics["Reference"]
+            if ref["first_tick"] >= applied_tick or time.monotonic() > deadline:
+                break
+        self.assertGreaterEqual(ref["first_tick"], applied_tick, "no Reference after the applied tick within 60 s")
+        self.assertAlmostEqual(ref["min"], NEW_HEIGHT, delta=1e-9)
+        self.assertAlmostEqual(ref["max"], NEW_HEIGHT, delta=1e-9)
+
+    def test_3_a_height_out_of_reach_is_rejected_with_the_reason(self):
+        code, r, err = cyclone("command", "--domain", DOMAIN, "--mode", "step_in_place", "--height", 0.9, "--wait", 30)
+        self.assertIsNotNone(r, err)
+        self.assertEqual((code, r["result"]), (1, "rejected"), (r, err))
+        self.assertIn("0.9", r["reason"])
+
+    def test_4_the_planner_counted_both_commands(self):
+        code = subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN)], env=self.env,
+                              capture_output=True, text=True, timeout=60).returncode
+        self.assertEqual(code, 0)
+        ops = json.loads((self.run_dir / "mft-planner.summary.json").read_text())["operator_commands"]
+        self.assertEqual((ops["received"], ops["applied"], ops["rejected"]), (2, 1, 1), ops)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -1,5 +1,5 @@
 #pragma once
-// What the planner hands to the WBC each tick. Field layout mirrors the `Reference` topic (idl/MftMsgs.idl):
+// What the planner hands to the WBC each tick. Field layout mirrors the `Reference` topic (idl/mft_msgs.idl):
 // [pos, vel, acc] triples for the base, world [x, z] per foot, right foot (leg 0) then left (leg 1).
 #include <Eigen/Core>
 #include <array>

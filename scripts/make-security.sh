@@ -132,9 +132,12 @@ openssl smime -sign -in governance.xml -text -out governance.p7s -signer ca.pem 
 
 NOT_BEFORE="$(date -u -d '-1 day' +%Y-%m-%dT%H:%M:%S)"
 NOT_AFTER="$(date -u -d "+$DAYS days" +%Y-%m-%dT%H:%M:%S)"
+# Topics by their DDS names, as the services create them (services/runtime/topic_names.hpp): ROS 2's
+# rt/mft/<snake_case>, e.g. SensorData -> rt/mft/sensor_data.
+dds_topic() { printf 'rt/mft/%s' "$(printf '%s' "$1" | sed -E 's/([a-z0-9])([A-Z])/\1_\2/g' | tr '[:upper:]' '[:lower:]')"; }
 topics_xml() {
   local t
-  for t in $1; do printf '            <topic>%s</topic>\n' "$t"; done
+  for t in $1; do printf '            <topic>%s</topic>\n' "$(dds_topic "$t")"; done
 }
 for id in "${IDENTITIES[@]}"; do
   {

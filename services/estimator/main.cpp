@@ -7,7 +7,7 @@
 #include <mutex>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "estimator/state_estimator.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/convert.hpp"

@@ -9,7 +9,7 @@
 #include <mutex>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "planner/motion_planner.hpp"
 #include "services/runtime/command_verdict.hpp"

@@ -29,12 +29,13 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/polling_udp_transport.hpp"
 #include "services/record/recorder.hpp"
 #include "services/runtime/dds_participant.hpp"
+#include "services/runtime/topic_names.hpp"
 #include "services/runtime/scenario.hpp"
 #include "services/runtime/service_context.hpp"
 #include "model/config/tool_io.hpp"
@@ -194,7 +195,7 @@ class RecorderParticipant {
   void enableProgress() {
     dds::TypeSupport type(new msg::RecorderProgressPubSubType());
     type.register_type(participant_);
-    auto* topic = participant_->create_topic("RecorderProgress", type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    auto* topic = participant_->create_topic(services::ddsTopicName("RecorderProgress"), type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
     publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
     if (!topic || !publisher_) throw services::DdsError("cannot create the RecorderProgress topic");
     progress_writer_ = publisher_->create_datawriter_with_profile(topic, "lockstep_writer");  // best effort: re-sent every 50 ms at worst
@@ -230,7 +231,7 @@ class Subscription : public dds::DataReaderListener {
       : subscriber_(p.subscriber()), recorder_(rec) {
     dds::TypeSupport type(new PubSubType());
     type.register_type(p.get());
-    topic_ = p.get()->create_topic(topic_name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    topic_ = p.get()->create_topic(services::ddsTopicName(topic_name), type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
     if (!topic_) throw services::DdsError("cannot create the topic " + topic_name);
     dds::DataReaderQos qos;
     if (subscriber_->get_datareader_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
@@ -343,6 +344,7 @@ static int toolMain(int argc, char** argv) {
   md.controller = scenario.controller;
   md.robot_checksum = model::checksumHex(robot.checksum);
   md.profiles = scenario.profiles;
+  md.dds_naming = services::kDdsNaming;
   const auto& profiles = config::activeProfiles();
   for (const char* f : {"robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml"}) {
     if (!fs::exists(config_file(f))) cli.fail("missing configuration " + config_file(f));

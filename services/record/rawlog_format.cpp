@@ -210,7 +210,7 @@ void toChannels(const Message& m, const std::string& label, double* p) {
     case Topic::Disturbance: {
       const auto& d = std::get<msg::Disturbance>(m);
       *p++ = static_cast<double>(d.seq());
-      *p++ = d.impulse_Ns();
+      *p++ = d.impulse();
       *p++ = d.trigger();
       *p++ = d.time_s();
       *p++ = d.leg();
@@ -313,7 +313,7 @@ void fromChannels(const std::string& label, const double* p, Message* m) {
     case Topic::Disturbance: {
       auto& d = std::get<msg::Disturbance>(*m);
       d.seq(d2u(*p++));
-      d.impulse_Ns(*p++);
+      d.impulse(*p++);
       d.trigger(static_cast<std::uint8_t>(*p++));
       d.time_s(*p++);
       d.leg(static_cast<std::int16_t>(*p++));
@@ -544,6 +544,8 @@ std::string metadataYaml(const Metadata& m) {
   e << YAML::Key << "robot_checksum" << YAML::Value << m.robot_checksum;
   e << YAML::Key << "profiles" << YAML::Value << YAML::Flow << m.profiles;
   e << YAML::Comment("config/profiles/ in force; config below holds the files with them applied");
+  e << YAML::Key << "dds_naming" << YAML::Value << m.dds_naming;
+  e << YAML::Comment("ros2: topics rt/mft/<snake_case>, types mft::msg::dds_::<Name>_ (docs/interop.md)");
   e << YAML::Key << "time_base_unix_ns" << YAML::Value << m.time_base_unix_ns;
   e << YAML::Comment("observation timestamp = time_base_unix_ns + stamp_ns of the simulator clock");
   e << YAML::Key << "piece" << YAML::Value << m.piece;
@@ -591,6 +593,7 @@ Metadata parseMetadata(const std::string& text) {
     m.controller = n["controller"].as<std::string>("");
     m.robot_checksum = n["robot_checksum"].as<std::string>("");
     if (n["profiles"] && n["profiles"].IsSequence()) m.profiles = n["profiles"].as<std::vector<std::string>>();
+    m.dds_naming = n["dds_naming"].as<std::string>("plain");
     m.time_base_unix_ns = n["time_base_unix_ns"].as<std::int64_t>();
     m.piece = n["piece"].as<int>(0);
     if (n["config"] && n["config"].IsMap())

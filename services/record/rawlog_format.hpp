@@ -17,7 +17,7 @@
 #include <variant>
 #include <vector>
 
-#include "MftMsgs.h"
+#include "idl/msg_types.hpp"
 
 namespace mft::rawlog {
 
@@ -115,6 +115,9 @@ struct Metadata {
   std::string scenario_file, scenario_name, controller;
   std::string robot_checksum;
   std::vector<std::string> profiles;  // configuration profiles in force (config/profiles/), in order
+  // The DDS names of the recorded stack: "ros2" (topics rt/mft/<snake>, types mft::msg::dds_::<Name>_,
+  // services/runtime/topic_names.hpp); files written before they existed say nothing and read as "plain".
+  std::string dds_naming = "plain";
   std::int64_t time_base_unix_ns = 0;  // observation timestamp = time_base + stamp_ns
   int piece = 0;
   std::map<std::string, std::string> config;  // file name (robot.yaml, ..., scenario, terrain/<x>.yaml) -> text

@@ -13,7 +13,7 @@
 #include <mutex>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "services/runtime/topic_io.hpp"
 
 namespace mft::services {

@@ -1,7 +1,7 @@
 #pragma once
 // Conversions between the libraries' plain structs and the DDS messages. Kept in one place so that a field
 // added to a topic touches one file. Copies only: no allocation.
-#include "MftMsgs.h"
+#include "idl/msg_types.hpp"
 #include "model/robot_io.hpp"
 #include "planner/plan_output.hpp"
 #include "wbc/wbc_reference.hpp"

@@ -1,4 +1,5 @@
 #include "services/runtime/dds_participant.hpp"
+#include "services/runtime/topic_names.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/log/Log.hpp>
@@ -126,8 +127,9 @@ Topic* DdsParticipant::topic(const std::string& topic_name, TopicDataType* type)
       throw DdsError("cannot register the DDS type " + type_name);
     types_.emplace(type_name, support);
   }
-  Topic* t = participant_->create_topic(topic_name, type_name, TOPIC_QOS_DEFAULT);
-  if (!t) throw DdsError("cannot create the DDS topic " + topic_name);
+  const std::string dds_name = ddsTopicName(topic_name);
+  Topic* t = participant_->create_topic(dds_name, type_name, TOPIC_QOS_DEFAULT);
+  if (!t) throw DdsError("cannot create the DDS topic " + dds_name);
   topics_[topic_name] = t;
   return t;
 }

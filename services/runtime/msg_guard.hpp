@@ -7,7 +7,7 @@
 // One overload per input topic.
 #include <cmath>
 
-#include "MftMsgs.h"
+#include "idl/msg_types.hpp"
 
 namespace mft::services {
 

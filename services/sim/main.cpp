@@ -16,7 +16,7 @@
 #include <mutex>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/command_verdict.hpp"
@@ -237,7 +237,7 @@ static int toolMain(int argc, char** argv) {
       });
   services::TopicReader<msg::Disturbance, msg::DisturbancePubSubType> push_reader(
       ctx.participant(), "Disturbance", "event_reader", [&](const msg::Disturbance& m) {
-        const auto verdict = services::checkDisturbance(m.impulse_Ns(), m.trigger(), m.time_s(), m.leg(), max_push_Ns);
+        const auto verdict = services::checkDisturbance(m.impulse(), m.trigger(), m.time_s(), m.leg(), max_push_Ns);
         std::lock_guard<std::mutex> lock(mutex);
         ++disturbances_received;
         const double now_s = static_cast<double>(published_tick) * options.control_period_s;
@@ -265,11 +265,11 @@ static int toolMain(int argc, char** argv) {
           else
             verdicts.post(seq, msg::VERDICT_REJECTED, published_tick, 0,
                           "impulse %.3f N s beyond the largest accepted push %.3f N s (mft-sim --max-push)",
-                          m.impulse_Ns(), max_push_Ns);
+                          m.impulse(), max_push_Ns);
           return;
         }
         sim::ImpulseSpec spec;
-        spec.impulse_Ns = {m.impulse_Ns(), 0.0};
+        spec.impulse_Ns = {m.impulse(), 0.0};
         spec.time_s = m.time_s();
         spec.trigger = m.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF ? sim::ImpulseTrigger::AtLiftOff
                                                                     : sim::ImpulseTrigger::AtTime;
@@ -279,11 +279,11 @@ static int toolMain(int argc, char** argv) {
         pending_pushes.push_back(spec);
         if (spec.trigger == sim::ImpulseTrigger::AtLiftOff)
           verdicts.post(m.seq(), msg::VERDICT_SCHEDULED, published_tick, 0,
-                        "push of %.3f N s will be applied at the next %s-foot lift-off", m.impulse_Ns(),
+                        "push of %.3f N s will be applied at the next %s-foot lift-off", m.impulse(),
                         spec.leg == 0 ? "right" : "left");
         else
           verdicts.post(m.seq(), msg::VERDICT_SCHEDULED, published_tick, 0, "push of %.3f N s will be applied at t = %.3f s",
-                        m.impulse_Ns(), std::max(spec.time_s, now_s));
+                        m.impulse(), std::max(spec.time_s, now_s));
       });
   // Lockstep recording: a starved recorder must slow the simulator down, not lose samples in its socket buffer.
   const auto recorder_window = static_cast<std::uint64_t>(cli.getInt("recorder-window", 0, 1000000));

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "model/mft_polytope.hpp"
 #include "services/runtime/convert.hpp"

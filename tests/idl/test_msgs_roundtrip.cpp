@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <iterator>
 
-#include "MftMsgs.h"
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_types.hpp"
+#include "idl/msg_pubsub.hpp"
 
 namespace {
 template <class Msg, class PubSub>
@@ -76,7 +76,7 @@ TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
   d.task_error()[5] = 1e-3;
   EXPECT_TRUE((roundTrip<mft::msg::WbcDiagnostics, mft::msg::WbcDiagnosticsPubSubType>(d) == d));
   mft::msg::Disturbance dist;
-  dist.impulse_Ns(7.1);
+  dist.impulse(7.1);
   dist.trigger(mft::msg::TRIGGER_AT_NEXT_LIFTOFF);
   EXPECT_TRUE((roundTrip<mft::msg::Disturbance, mft::msg::DisturbancePubSubType>(dist) == dist));
   mft::msg::CommandVerdict verdict;

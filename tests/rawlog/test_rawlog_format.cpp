@@ -19,7 +19,7 @@
 #include <random>
 #include <set>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/record/recorder.hpp"
 
@@ -289,6 +289,23 @@ TEST(RawlogReader, RefusesFilesThatAreNotMftRawlogs) {
 
 // A field added to a topic must be added to the rawlog format (and the schema version bumped), or replays
 // would silently lose it: the serialized sizes pin the message layouts the format knows.
+// A recording says which DDS names its stack used; a file from before the ROS 2 names says nothing and reads as
+// "plain" (and is read like any other).
+TEST(RawlogFormat, MetadataRecordsTheDdsNamingAndOlderFilesReadAsPlain) {
+  Metadata m = testMetadata();
+  m.dds_naming = "ros2";
+  const std::string text = metadataYaml(m);
+  EXPECT_EQ(parseMetadata(text).dds_naming, "ros2");
+  std::string older;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("dds_naming:", 0) != 0) older += line + "\n";
+  ASSERT_EQ(older.find("dds_naming"), std::string::npos);
+  const Metadata parsed = parseMetadata(older);
+  EXPECT_EQ(parsed.dds_naming, "plain");
+  EXPECT_EQ(parsed.scenario_name, "unit");
+}
+
 TEST(RawlogFormat, KnowsEveryFieldOfEveryTopic) {
   EXPECT_EQ(msg::GroundTruthPubSubType().m_typeSize, 244u) << "GroundTruth changed: update rawlog_format.cpp";
   EXPECT_EQ(msg::SensorDataPubSubType().m_typeSize, 208u) << "SensorData changed: update rawlog_format.cpp";

@@ -7,9 +7,10 @@
 
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 
-#include "MftMsgs.h"
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_types.hpp"
+#include "idl/msg_pubsub.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "services/runtime/topic_names.hpp"
 
 using namespace mft::services;
 using namespace std::chrono_literals;
@@ -114,4 +115,24 @@ TEST(PollingReceive, BurstsArriveWholeInOrderAndInBatches) {
   EXPECT_GT(stats.polls.load(), 0u);
   // A burst written within one period is taken in one poll: the readers were not woken per datagram.
   EXPECT_GE(stats.max_datagrams_per_poll.load(), 5u);
+}
+
+// ROS 2's names on the wire (docs/interop.md#ros-2): topic rt/mft/<snake_case>, type mft::msg::dds_::<Name>_.
+TEST(DdsNames, TopicNamesAreRos2Names) {
+  EXPECT_EQ(ddsTopicName("SensorData"), "rt/mft/sensor_data");
+  EXPECT_EQ(ddsTopicName("WbcDiagnostics"), "rt/mft/wbc_diagnostics");
+  EXPECT_EQ(ddsTopicName("OperatorCommand"), "rt/mft/operator_command");
+  EXPECT_EQ(ddsTopicName("Reference"), "rt/mft/reference");
+}
+
+TEST(DdsNames, AParticipantCreatesItsTopicsUnderRos2NamesAndTypes) {
+  DdsParticipant p(testDomain(), MFT_DDS_PROFILES, "test_names");
+  auto* sensor = p.topic("SensorData", new mft::msg::SensorDataPubSubType());
+  ASSERT_NE(sensor, nullptr);
+  EXPECT_EQ(sensor->get_name(), "rt/mft/sensor_data");
+  EXPECT_EQ(sensor->get_type_name(), "mft::msg::dds_::SensorData_");
+  auto* verdict = p.topic("CommandVerdict", new mft::msg::CommandVerdictPubSubType());
+  ASSERT_NE(verdict, nullptr);
+  EXPECT_EQ(verdict->get_name(), "rt/mft/command_verdict");
+  EXPECT_EQ(verdict->get_type_name(), "mft::msg::dds_::CommandVerdict_");
 }

@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "MftMsgs.h"
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_types.hpp"
+#include "idl/msg_pubsub.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
@@ -133,7 +133,7 @@ static int toolMain(int argc, char** argv) {
     what_text = mode + ", height " + fmt(command.z_cmd(), 3) + " m, speed " + fmt(command.v_cmd(), 3) + " m/s";
   } else {
     push.seq(seq);
-    push.impulse_Ns(cli.getDouble("push", -1e4, 1e4));
+    push.impulse(cli.getDouble("push", -1e4, 1e4));
     push.time_s(cli.getDouble("at", 0.0, 1e6));
     push.trigger(msg::TRIGGER_AT_TIME);
     push.leg(-1);
@@ -146,10 +146,10 @@ static int toolMain(int argc, char** argv) {
     topic = "Disturbance";
     answerer = "mft-sim";
     const bool liftoff = push.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF;
-    what_json = "\"impulse_Ns\": " + fmt(push.impulse_Ns(), -6) + ", \"trigger\": \"" +
+    what_json = "\"impulse_Ns\": " + fmt(push.impulse(), -6) + ", \"trigger\": \"" +
                 (liftoff ? "at_next_liftoff" : "at_time") + "\", \"time_s\": " + fmt(push.time_s(), -6) +
                 ", \"leg\": " + std::to_string(push.leg());
-    what_text = fmt(push.impulse_Ns(), 3) + " N s " +
+    what_text = fmt(push.impulse(), 3) + " N s " +
                 (liftoff ? std::string("at the next ") + (push.leg() == 0 ? "right" : "left") + "-foot lift-off"
                          : cli.isSet("at") ? "at t = " + fmt(push.time_s(), 3) + " s" : std::string("now"));
   }

@@ -1,5 +1,5 @@
 // mft-cyclone: a second DDS vendor on the stack's topics. Built with Eclipse Cyclone DDS from the project's own
-// IDL (idl/MftMsgs.idl through Cyclone's idlc), it reads what the Fast DDS stack publishes and sends it an
+// IDL (idl/mft_msgs.idl through Cyclone's idlc), it reads what the Fast DDS stack publishes and sends it an
 // OperatorCommand, so that a test can show that another implementation interoperates with ours (wire protocol,
 // type names, QoS). docs/interop.md.
 #include <dds/dds.h>
@@ -12,7 +12,7 @@
 #include <ctime>
 
 extern "C" {
-#include "MftMsgs.h"
+#include "mft_msgs.h"
 }
 
 enum { EXIT_OK = 0, EXIT_REJECTED = 1, EXIT_USAGE = 2, EXIT_NO_DATA = 3, EXIT_NO_VERDICT = 5 };
@@ -22,13 +22,14 @@ static const char *const kUsage =
     "       mft-cyclone command --domain N --mode stand|step_in_place|walk --height Z [--speed V] [--wait S]\n"
     "                           [--topic-prefix P] [--json]\n"
     "\n"
-    "A Cyclone DDS participant on the mft-wbc topics (docs/interop.md), built from idl/MftMsgs.idl.\n"
+    "A Cyclone DDS participant on the mft-wbc topics (docs/interop.md), built from idl/mft_msgs.idl.\n"
     "listen : reads SensorData, JointCommand and Reference for --seconds (default 3) or until each topic has\n"
     "         --min-samples samples; prints per topic: samples, first/last tick, tick decreases, non-finite\n"
     "         values, and value ranges (joint positions, torques, reference height). Exit 3 if a topic is silent.\n"
     "command: sends one OperatorCommand (reliable, transient-local, as mft-cmd does) and waits --wait seconds\n"
     "         (default 10) for the planner's CommandVerdict with its seq. Exit 0 applied, 1 rejected, 5 none.\n"
-    "Only loopback is used (Cyclone's lo interface with multicast discovery, as the stack's profiles).\n";
+    "Topics are named as ROS 2 names them, --topic-prefix (default rt/mft/) + snake_case type name; types\n"
+    "mft::msg::dds_::<Name>_. Only loopback is used (Cyclone's lo interface with multicast discovery).\n";
 
 static double now_s(void) {
   struct timespec t;
@@ -123,12 +124,12 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
     return EXIT_USAGE;
   }
   char n_sensor[128], n_command[128], n_reference[128];
-  snprintf(n_sensor, sizeof n_sensor, "%sSensorData", prefix);
-  snprintf(n_command, sizeof n_command, "%sJointCommand", prefix);
-  snprintf(n_reference, sizeof n_reference, "%sReference", prefix);
-  const dds_entity_t r_sensor = make_reader(participant, &mft_msg_SensorData_desc, n_sensor, false);
-  const dds_entity_t r_command = make_reader(participant, &mft_msg_JointCommand_desc, n_command, false);
-  const dds_entity_t r_reference = make_reader(participant, &mft_msg_Reference_desc, n_reference, false);
+  snprintf(n_sensor, sizeof n_sensor, "%ssensor_data", prefix);
+  snprintf(n_command, sizeof n_command, "%sjoint_command", prefix);
+  snprintf(n_reference, sizeof n_reference, "%sreference", prefix);
+  const dds_entity_t r_sensor = make_reader(participant, &mft_msg_dds__SensorData__desc, n_sensor, false);
+  const dds_entity_t r_command = make_reader(participant, &mft_msg_dds__JointCommand__desc, n_command, false);
+  const dds_entity_t r_reference = make_reader(participant, &mft_msg_dds__Reference__desc, n_reference, false);
   if (r_sensor < 0 || r_command < 0 || r_reference < 0) {
     fprintf(stderr, "mft-cyclone: cannot create the readers\n");
     dds_delete(participant);
@@ -157,7 +158,7 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
     int n = dds_take(r_sensor, samples, infos, 16, 16);
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_SensorData*>(samples[i]);
+      const auto* m = static_cast<const mft_msg_dds__SensorData_*>(samples[i]);
       stats_add(&sensor, m->tick, m->actuated_pos, 4);
     }
     if (n > 0) dds_return_loan(r_sensor, samples, n);
@@ -165,7 +166,7 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
     n = dds_take(r_command, samples, infos, 16, 16);
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_JointCommand*>(samples[i]);
+      const auto* m = static_cast<const mft_msg_dds__JointCommand_*>(samples[i]);
       stats_add(&command, m->tick, m->tau, 4);
     }
     if (n > 0) dds_return_loan(r_command, samples, n);
@@ -173,7 +174,7 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
     n = dds_take(r_reference, samples, infos, 16, 16);
     for (int i = 0; i < n; ++i) {
       if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_Reference*>(samples[i]);
+      const auto* m = static_cast<const mft_msg_dds__Reference_*>(samples[i]);
       stats_add(&reference, m->tick, &m->base_z[0], 1);
     }
     if (n > 0) dds_return_loan(r_reference, samples, n);
@@ -200,18 +201,18 @@ static int cmd_command(int domain, int mode, double height, double speed, double
     return EXIT_USAGE;
   }
   char n_command[128], n_verdict[128];
-  snprintf(n_command, sizeof n_command, "%sOperatorCommand", prefix);
-  snprintf(n_verdict, sizeof n_verdict, "%sCommandVerdict", prefix);
+  snprintf(n_command, sizeof n_command, "%soperator_command", prefix);
+  snprintf(n_verdict, sizeof n_verdict, "%scommand_verdict", prefix);
   /* The verdict reader first, so that the answer cannot come before it exists (the planner's writer keeps its
    * history for late readers anyway: reliable, transient-local). */
-  dds_entity_t t_verdict = dds_create_topic(participant, &mft_msg_CommandVerdict_desc, n_verdict, NULL, NULL);
+  dds_entity_t t_verdict = dds_create_topic(participant, &mft_msg_dds__CommandVerdict__desc, n_verdict, NULL, NULL);
   dds_qos_t *rq = dds_create_qos();
   dds_qset_reliability(rq, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(rq, DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(rq, DDS_HISTORY_KEEP_LAST, 16);
   const dds_entity_t r_verdict = dds_create_reader(participant, t_verdict, rq, NULL);
   dds_delete_qos(rq);
-  dds_entity_t t_command = dds_create_topic(participant, &mft_msg_OperatorCommand_desc, n_command, NULL, NULL);
+  dds_entity_t t_command = dds_create_topic(participant, &mft_msg_dds__OperatorCommand__desc, n_command, NULL, NULL);
   dds_qos_t *wq = dds_create_qos();
   dds_qset_reliability(wq, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
   dds_qset_durability(wq, DDS_DURABILITY_TRANSIENT_LOCAL);
@@ -230,7 +231,7 @@ static int cmd_command(int domain, int mode, double height, double speed, double
     if (dds_get_publication_matched_status(writer, &pm) == 0 && pm.current_count > 0) break;
     dds_sleepfor(DDS_MSECS(10));
   }
-  mft_msg_OperatorCommand cmd;
+  mft_msg_dds__OperatorCommand_ cmd;
   memset(&cmd, 0, sizeof cmd);
   cmd.seq = ((unsigned long long)getpid() << 20) ^ (unsigned long long)(now_s() * 1e6);
   cmd.z_cmd = height;
@@ -242,7 +243,7 @@ static int cmd_command(int domain, int mode, double height, double speed, double
     return EXIT_USAGE;
   }
   int result = EXIT_NO_VERDICT;
-  mft_msg_CommandVerdict got;
+  mft_msg_dds__CommandVerdict_ got;
   memset(&got, 0, sizeof got);
   void *samples[16];
   dds_sample_info_t infos[16];
@@ -250,7 +251,7 @@ static int cmd_command(int domain, int mode, double height, double speed, double
     memset(samples, 0, sizeof samples);
     const int n = dds_take(r_verdict, samples, infos, 16, 16);
     for (int i = 0; i < n; ++i) {
-      const auto* v = static_cast<const mft_msg_CommandVerdict*>(samples[i]);
+      const auto* v = static_cast<const mft_msg_dds__CommandVerdict_*>(samples[i]);
       if (!infos[i].valid_data || v->seq != cmd.seq || v->source != mft_msg_COMMAND_SOURCE_PLANNER) continue;
       if (v->verdict == mft_msg_VERDICT_SCHEDULED) continue; /* wait for APPLIED */
       got = *v;
@@ -290,7 +291,7 @@ int main(int argc, char **argv) {
   if (!listen && !command) return usage_error("the first argument must be listen or command");
   double domain = -1, seconds = 3, min_samples = 0, height = std::nan(""), speed = 0, wait_s = 10;
   int mode = -1;
-  const char *prefix = "";
+  const char *prefix = "rt/mft/";
   bool json = false;
   for (int i = 2; i < argc; ++i) {
     const char *a = argv[i];

@@ -171,13 +171,13 @@ int exportMain(int argc, char** argv) {
       labels_json += buf;
     }
     std::printf("{\"file\": \"%s\", \"format\": \"%s\", \"schema_version\": %d, \"scenario\": \"%s\", \"mode\": \"%s\", "
-                "\"controller\": \"%s\", \"created_utc\": \"%s\", \"robot_checksum\": \"%s\", \"piece\": %d, "
+                "\"controller\": \"%s\", \"created_utc\": \"%s\", \"robot_checksum\": \"%s\", \"dds_naming\": \"%s\", \"piece\": %d, "
                 "\"time_base_unix_ns\": %lld, \"first_unix_s\": %.6f, \"last_unix_s\": %.6f, \"file_bytes\": %llu, "
                 "\"objects\": %llu, \"unknown_objects\": %llu, \"labels\": {%s}, \"end\": \"%s\", "
                 "\"end_message\": \"%s\", \"csv_dir\": \"%s\"}\n",
                 jsonEscape(file).c_str(), jsonEscape(md.format).c_str(), md.schema_version, jsonEscape(md.scenario_name).c_str(),
                 jsonEscape(md.mode).c_str(), jsonEscape(md.controller).c_str(), jsonEscape(md.created_utc).c_str(),
-                jsonEscape(md.robot_checksum).c_str(), md.piece,
+                jsonEscape(md.robot_checksum).c_str(), jsonEscape(md.dds_naming).c_str(), md.piece,
                 static_cast<long long>(md.time_base_unix_ns), first_unix_ns < 0 ? 0.0 : static_cast<double>(first_unix_ns) * 1e-9,
                 static_cast<double>(last_unix_ns) * 1e-9, static_cast<unsigned long long>(reader->fileSize()),
                 static_cast<unsigned long long>(reader->objects()), static_cast<unsigned long long>(unknown),
@@ -186,8 +186,9 @@ int exportMain(int argc, char** argv) {
   } else {
     std::printf("file       %s (%.2f MB, schema %d, piece %d)\n", file.c_str(), static_cast<double>(reader->fileSize()) / 1e6,
                 md.schema_version, md.piece);
-    std::printf("run        %s, %s, controller %s, recorded %s, robot %s\n", md.scenario_name.c_str(), md.mode.c_str(),
-                md.controller.c_str(), md.created_utc.c_str(), md.robot_checksum.c_str());
+    std::printf("run        %s, %s, controller %s, recorded %s, robot %s, DDS names %s\n", md.scenario_name.c_str(),
+                md.mode.c_str(), md.controller.c_str(), md.created_utc.c_str(), md.robot_checksum.c_str(),
+                md.dds_naming.c_str());
     std::printf("%-16s %-16s %8s %12s %12s %10s %10s %6s\n", "label", "topic", "count", "first [s]", "last [s]",
                 "first tick", "last tick", "gaps");
     for (std::size_t i = 0; i < specs.size(); ++i) {

@@ -28,8 +28,8 @@
 #include <thread>
 #include <vector>
 
-#include "MftMsgs.h"
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_types.hpp"
+#include "idl/msg_pubsub.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
@@ -96,7 +96,7 @@ void doubles(msg::WbcDiagnostics& m, const std::function<void(const std::string&
   each("raci", m.raci(), f);
 }
 void doubles(msg::Disturbance& m, const std::function<void(const std::string&, double&)>& f) {
-  f("impulse_Ns", m.impulse_Ns());
+  f("impulse", m.impulse());
   f("time_s", m.time_s());
 }
 void enumsOutOfRange(msg::OperatorCommand& m) { m.mode(99); }

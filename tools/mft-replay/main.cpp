@@ -13,7 +13,7 @@
 #include <sstream>
 #include <thread>
 
-#include "MftMsgsPubSubTypes.h"
+#include "idl/msg_pubsub.hpp"
 #include "model/mft_polytope.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/runtime/convert.hpp"

@@ -6,14 +6,7 @@
 #include "mft_msgsPubSubTypes.h"
 
 namespace mft::msg {
-using SensorDataPubSubType = dds_::SensorData_PubSubType;
-using GroundTruthPubSubType = dds_::GroundTruth_PubSubType;
-using RobotStatePubSubType = dds_::RobotState_PubSubType;
-using OperatorCommandPubSubType = dds_::OperatorCommand_PubSubType;
-using ReferencePubSubType = dds_::Reference_PubSubType;
-using JointCommandPubSubType = dds_::JointCommand_PubSubType;
-using WbcDiagnosticsPubSubType = dds_::WbcDiagnostics_PubSubType;
-using RecorderProgressPubSubType = dds_::RecorderProgress_PubSubType;
-using DisturbancePubSubType = dds_::Disturbance_PubSubType;
-using CommandVerdictPubSubType = dds_::CommandVerdict_PubSubType;
+#define MFT_MSG_PUBSUB_ALIAS(Name) using Name##PubSubType = dds_::Name##_PubSubType;
+MFT_MSG_TYPES(MFT_MSG_PUBSUB_ALIAS)
+#undef MFT_MSG_PUBSUB_ALIAS
 }  // namespace mft::msg

@@ -5,15 +5,21 @@
 
 #include "mft_msgs.h"
 
+// Every struct of idl/mft_msgs.idl, for the aliases here and in idl/msg_pubsub.hpp.
+#define MFT_MSG_TYPES(X) \
+  X(SensorData)          \
+  X(GroundTruth)         \
+  X(RobotState)          \
+  X(OperatorCommand)     \
+  X(Reference)           \
+  X(JointCommand)        \
+  X(WbcDiagnostics)      \
+  X(RecorderProgress)    \
+  X(Disturbance)         \
+  X(CommandVerdict)
+
 namespace mft::msg {
-using SensorData = dds_::SensorData_;
-using GroundTruth = dds_::GroundTruth_;
-using RobotState = dds_::RobotState_;
-using OperatorCommand = dds_::OperatorCommand_;
-using Reference = dds_::Reference_;
-using JointCommand = dds_::JointCommand_;
-using WbcDiagnostics = dds_::WbcDiagnostics_;
-using RecorderProgress = dds_::RecorderProgress_;
-using Disturbance = dds_::Disturbance_;
-using CommandVerdict = dds_::CommandVerdict_;
+#define MFT_MSG_TYPE_ALIAS(Name) using Name = dds_::Name##_;
+MFT_MSG_TYPES(MFT_MSG_TYPE_ALIAS)
+#undef MFT_MSG_TYPE_ALIAS
 }  // namespace mft::msg

@@ -117,6 +117,17 @@ static dds_entity_t make_reader(dds_entity_t participant, const dds_topic_descri
   return reader;
 }
 
+// Takes every sample waiting on `reader` and hands each valid one to `use`.
+template <class Msg, class Use>
+static void takeAll(dds_entity_t reader, Use use) {
+  void* samples[16] = {};
+  dds_sample_info_t infos[16];
+  const int n = dds_take(reader, samples, infos, 16, 16);
+  for (int i = 0; i < n; ++i)
+    if (infos[i].valid_data) use(*static_cast<const Msg*>(samples[i]));
+  if (n > 0) dds_return_loan(reader, samples, n);
+}
+
 static int cmd_listen(int domain, double seconds, long min_samples, const char *prefix, bool json) {
   dds_entity_t participant = make_participant(domain);
   if (participant < 0) {
@@ -147,37 +158,14 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
     dds_waitset_attach(waitset, conds[i], i);
   }
   const double t_end = now_s() + seconds;
-  void *samples[16];
-  dds_sample_info_t infos[16];
   while (now_s() < t_end) {
     if (min_samples > 0 && sensor.samples >= min_samples && command.samples >= min_samples &&
         reference.samples >= min_samples)
       break;
     dds_waitset_wait(waitset, NULL, 0, DDS_MSECS(50));
-    memset(samples, 0, sizeof samples);
-    int n = dds_take(r_sensor, samples, infos, 16, 16);
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_dds__SensorData_*>(samples[i]);
-      stats_add(&sensor, m->tick, m->actuated_pos, 4);
-    }
-    if (n > 0) dds_return_loan(r_sensor, samples, n);
-    memset(samples, 0, sizeof samples);
-    n = dds_take(r_command, samples, infos, 16, 16);
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_dds__JointCommand_*>(samples[i]);
-      stats_add(&command, m->tick, m->tau, 4);
-    }
-    if (n > 0) dds_return_loan(r_command, samples, n);
-    memset(samples, 0, sizeof samples);
-    n = dds_take(r_reference, samples, infos, 16, 16);
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      const auto* m = static_cast<const mft_msg_dds__Reference_*>(samples[i]);
-      stats_add(&reference, m->tick, &m->base_z[0], 1);
-    }
-    if (n > 0) dds_return_loan(r_reference, samples, n);
+    takeAll<mft_msg_dds__SensorData_>(r_sensor, [&](const auto& m) { stats_add(&sensor, m.tick, m.actuated_pos, 4); });
+    takeAll<mft_msg_dds__JointCommand_>(r_command, [&](const auto& m) { stats_add(&command, m.tick, m.tau, 4); });
+    takeAll<mft_msg_dds__Reference_>(r_reference, [&](const auto& m) { stats_add(&reference, m.tick, &m.base_z[0], 1); });
   }
   if (json) printf("{\n \"domain\": %d,\n \"topics\": {\n", domain);
   stats_print(&sensor, json, "actuated_pos [rad]", false);

@@ -9,6 +9,7 @@ Measures, through services/mft-supervisor and the real services:
 Speed figures depend on the machine and on its load: run it on an idle machine (the load is printed).
 """
 import argparse
+import importlib.util
 import json
 import os
 import statistics
@@ -26,15 +27,27 @@ def progress(msg):
     print(msg, file=sys.stderr, flush=True)
 
 
-def run_stack(args, tmp, scenario, mode, record=False, tag=""):
+def hop_table_module():
+    spec = importlib.util.spec_from_file_location("hop_table", REPO / "scripts" / "hop-table.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def run_stack(args, tmp, scenario, mode, record=False, tag="", hops=False):
     run_dir = Path(tmp) / f"run-{mode}-{tag}"
+    env = dict(os.environ)
+    env.pop("MFT_HOP_TRACE", None)
+    if hops:  # the services write <service>.hops.csv into the run folder (services/runtime/hop_trace.hpp)
+        run_dir.mkdir(parents=True, exist_ok=True)
+        env["MFT_HOP_TRACE"] = str(run_dir)
     cmd = [sys.executable, str(SUPERVISOR), "run", str(scenario), "--domain", str(args.domain), "--mode", mode,
            "--json", "--run-dir", str(run_dir), "--bin-dir", str(args.bin_dir)]
     if record:
         cmd += ["--record", str(Path(tmp) / f"{tag}.rawlog")]
     if args.chain_cpu is not None:
         cmd += ["--chain-cpu", str(args.chain_cpu)]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.realtime_s + 300)
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.realtime_s + 300, env=env)
     try:
         summary = json.loads(p.stdout)
     except ValueError:
@@ -43,6 +56,8 @@ def run_stack(args, tmp, scenario, mode, record=False, tag=""):
         sys.exit(f"measure-stack: the {mode} run failed: {summary.get('error')} {summary.get('failed')}")
     if record:
         os.unlink(Path(tmp) / f"{tag}.rawlog")
+    if hops:
+        summary["hop_table"] = hop_table_module().hop_table(run_dir)
     return summary
 
 
@@ -55,6 +70,8 @@ def main():
     ap.add_argument("--chain-cpu", type=int, metavar="N", help="pass --chain-cpu N to the supervisor (chain on CPU N, "
                     "recorder on the others)")
     ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
+    ap.add_argument("--hops", action="store_true", help="trace the plain lockstep runs (MFT_HOP_TRACE) and print the "
+                    "per-hop table of the median one (scripts/hop-table.py; docs/loop-benchmark.md)")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = ap.parse_args()
     if not (Path(args.bin_dir) / "mft-sim").exists():
@@ -67,7 +84,8 @@ def main():
         plain, recorded = [], []
         for i in range(args.runs):
             progress(f"lockstep run {i + 1}/{args.runs} without and with recording ...")
-            plain.append(run_stack(args, tmp, SCENARIO, "lockstep", tag=f"plain{i}")["services"]["mft-sim"])
+            s = run_stack(args, tmp, SCENARIO, "lockstep", tag=f"plain{i}", hops=args.hops)
+            plain.append(dict(s["services"]["mft-sim"], hop_table=s.get("hop_table")))
             rec = run_stack(args, tmp, SCENARIO, "lockstep", record=True, tag=f"rec{i}")
             recorded.append(rec["services"]["mft-sim"])
             dropped = rec["services"]["mft-record"]["dropped_samples"]
@@ -89,6 +107,9 @@ def main():
             "recording_slowdown_paired": sorted(round(r / p, 3) for r, p in zip(wall_rec, wall_plain)),
             "resends": sum(s.get("lockstep_resends", 0) for s in plain + recorded),
         }
+        if args.hops:  # the table of the plain run with the median wall time
+            median_run = sorted(plain, key=lambda s: s["wall_time_s"])[len(plain) // 2]
+            out["lockstep"]["hop_table"] = median_run["hop_table"]
         if not args.skip_realtime:
             scenario = Path(tmp) / "step-in-place-long.yaml"
             text = SCENARIO.read_text().replace("duration_s: 10.0", f"duration_s: {args.realtime_s}")
@@ -112,6 +133,9 @@ def main():
           f"{ls['recording_real_time_factor_median']}x real time, slowdown x{ls['recording_slowdown_median']} "
           f"(best x{ls['recording_slowdown_best']}, paired median x{statistics.median(ls['recording_slowdown_paired']):.3f}); "
           f"tick re-sends {ls['resends']}")
+    if "hop_table" in ls:
+        print("per-hop table of the median plain lockstep run [us]:")
+        hop_table_module().print_table(ls["hop_table"])
     if "realtime" in out:
         rt = out["realtime"]
         lat = rt["sensor_to_command_latency_us"]

@@ -11,6 +11,7 @@
 #include "estimator/state_estimator.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/convert.hpp"
+#include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
@@ -44,6 +45,7 @@ static int toolMain(int argc, char** argv) {
   model::GroundTruthState truth;
   bool have_sensors = false, have_truth = false, initialized = false, answered = false;
   std::uint64_t last_tick = 0, ticks = 0, refused_inputs = 0;
+  services::HopTrace hops("mft-estimator", {"sensor_in", "write", "written"});
   services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   msg::RobotState out_msg;
   services::LatencyStats update_us;
@@ -70,7 +72,9 @@ static int toolMain(int argc, char** argv) {
     services::toMsg(estimate, &out_msg);
     out_msg.stamp_ns(services::toStampNs(sensors.time_s));
     update_us.add(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    hops.mark(1, sensors.tick);
     writer.write(out_msg);
+    hops.mark(2, sensors.tick);
     last_tick = sensors.tick;
     gate.answered(last_tick);
     answered = true;
@@ -78,6 +82,7 @@ static int toolMain(int argc, char** argv) {
   };
   services::TopicReader<msg::SensorData, msg::SensorDataPubSubType> sensor_reader(
       ctx.participant(), "SensorData", ctx.chainReaderProfile(), [&](const msg::SensorData& m) {
+        hops.mark(0, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         if (!services::validInput(m)) {  // a NaN would stay in the filter for good
           if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));

@@ -14,6 +14,7 @@
 #include "planner/motion_planner.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/convert.hpp"
+#include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
@@ -75,6 +76,7 @@ static int toolMain(int argc, char** argv) {
   std::size_t next_command = 0;
   std::uint64_t last_tick = 0, ticks = 0, rejected = 0, refused_inputs = 0;
   bool answered = false;
+  services::HopTrace hops("mft-planner", {"state_in", "write", "written"});
   services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   msg::Reference out_msg;
   model::RobotStateEstimate state;
@@ -106,6 +108,7 @@ static int toolMain(int argc, char** argv) {
                                                                          ctx.chainWriterProfile());
   services::TopicReader<msg::RobotState, msg::RobotStatePubSubType> state_reader(
       ctx.participant(), "RobotState", ctx.chainReaderProfile(), [&](const msg::RobotState& m) {
+        hops.mark(0, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         if (!services::validInput(m)) {  // keep the last good state; the real sample of this tick still comes
           if (refused_inputs++ == 0) std::printf("mft-planner: refused a non-finite or implausible RobotState (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
@@ -146,7 +149,9 @@ static int toolMain(int argc, char** argv) {
         out_msg.tick(m.tick());
         out_msg.stamp_ns(m.stamp_ns());
         update_us.add(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+        hops.mark(1, m.tick());
         writer.write(out_msg);
+        hops.mark(2, m.tick());
         last_tick = m.tick();
         gate.answered(last_tick);
         answered = true;

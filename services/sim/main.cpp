@@ -23,6 +23,7 @@
 #include "services/runtime/command_watchdog.hpp"
 #include "services/runtime/stall_probe.hpp"
 #include "services/runtime/convert.hpp"
+#include "services/runtime/hop_trace.hpp"
 #include "services/runtime/input_guard.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/push_recovery.hpp"
@@ -206,6 +207,9 @@ static int toolMain(int argc, char** argv) {
     // Older than the ring: its oldest entry is the earliest publication still known (conservative).
     return publish_ns[(published_tick - oldest >= n ? published_tick + 1 : oldest) % n];
   };
+  // publish: the tick's samples are written; command_in: its JointCommand reaches the listener; wake: the loop
+  // holds it; stepped: the physics step is done.
+  services::HopTrace hops("mft-sim", {"publish", "published", "command_in", "wake", "stepped"});
   services::LatencyStats wakeup_late_us;  // realtime: how late the simulator's own loop woke up
 
   services::TopicWriter<msg::SensorData, msg::SensorDataPubSubType> sensor_writer(ctx.participant(), "SensorData",
@@ -214,6 +218,7 @@ static int toolMain(int argc, char** argv) {
                                                                                    ctx.chainWriterProfile());
   services::TopicReader<msg::JointCommand, msg::JointCommandPubSubType> command_reader(
       ctx.participant(), "JointCommand", ctx.chainReaderProfile(), [&](const msg::JointCommand& m) {
+        hops.mark(2, m.tick());
         const std::int64_t t = nowNs();
         std::lock_guard<std::mutex> lock(mutex);
         ++commands_received;
@@ -312,8 +317,12 @@ static int toolMain(int argc, char** argv) {
       published_tick = simulator.tick();
       publish_ns[published_tick % publish_ns.size()] = nowNs();
     }
-    truth_writer.write(truth_msg);
+    hops.mark(0, simulator.tick());
+    // SensorData first: it is what the estimator answers; GroundTruth (needed by the estimator only at its
+    // first tick and in ground-truth mode, where it waits for both) then goes out while the chain computes.
     sensor_writer.write(sensor_msg);
+    truth_writer.write(truth_msg);
+    hops.mark(1, simulator.tick());
   };
 
   // Readiness of the chain: the estimator listens and the controller's command writer is there.
@@ -421,6 +430,7 @@ static int toolMain(int argc, char** argv) {
         break;
       }
       command = latest;
+      hops.mark(3, k);
       if (k == 0) {
         // The loop's wall time starts here, as in realtime: tick 0 waits for discovery (and for the recorder
         // to hear every topic), re-sent every 100 ms, which is start-up, not the speed of the loop.
@@ -490,6 +500,7 @@ static int toolMain(int argc, char** argv) {
     }
     simulator.setCommand(command);
     simulator.step();
+    hops.mark(4, k);
     const bool fell_now = monitor.update(simulator.groundTruth(), commandedHeight(scenario, simulator.time()),
                                          simulator.stats().body_contact_steps);
     {

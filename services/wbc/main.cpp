@@ -14,6 +14,7 @@
 #include "model/config/strict_yaml.hpp"
 #include "model/mft_polytope.hpp"
 #include "services/runtime/convert.hpp"
+#include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
@@ -95,6 +96,7 @@ static int toolMain(int argc, char** argv) {
   wbc::WbcReference reference;
   bool have_state = false, have_reference = false, answered = false;
   std::uint64_t last_tick = 0, seq = 0, ticks = 0, non_optimal = 0, refused_inputs = 0;
+  services::HopTrace hops("mft-wbc", {"state_in", "reference_in", "compute", "write", "written"});
   services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   int max_iterations = 0;
   msg::JointCommand command_msg;
@@ -121,12 +123,15 @@ static int toolMain(int argc, char** argv) {
       return;
     }
     if (answered && state.tick < last_tick) return;
+    hops.mark(2, state.tick);
     const model::ActuatorCommand command = controller.update(state, reference, &diag);
     diag.tick = state.tick;
     const std::uint64_t stamp_ns = services::toStampNs(state.time_s);
     services::toMsg(command, stamp_ns, ++seq, &command_msg);
     command_msg.tick(state.tick);
+    hops.mark(3, state.tick);
     command_writer.write(command_msg);
+    hops.mark(4, state.tick);
     toMsg(diag, stamp_ns, &diag_msg);
     diag_writer.write(diag_msg);
     solve_us.add(diag.solve_time_us);
@@ -142,6 +147,7 @@ static int toolMain(int argc, char** argv) {
   };
   services::TopicReader<msg::RobotState, msg::RobotStatePubSubType> state_reader(
       ctx.participant(), "RobotState", ctx.chainReaderProfile(), [&](const msg::RobotState& m) {
+        hops.mark(0, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         // A non-finite input never overwrites the last good one (the safety stage would damp for as long as
         // it comes); the real sample of the same tick is still answered.
@@ -162,6 +168,7 @@ static int toolMain(int argc, char** argv) {
       });
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
+        hops.mark(1, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         if (!services::validInput(m)) {
           if (refused_inputs++ == 0) std::printf("mft-wbc: refused a non-finite or implausible Reference (tick %llu)\n", static_cast<unsigned long long>(m.tick()));

@@ -2,6 +2,7 @@
 """Integration tests of the multi-process stack: real mft-sim, mft-estimator, mft-planner and mft-wbc processes
 started through services/mft-supervisor, each test on its own DDS domain, bounded in time, every process
 cleaned up even on failure. Needs MFT_BIN_DIR (set by CTest) pointing at the built executables."""
+import importlib.util
 import json
 import os
 import shutil
@@ -21,6 +22,10 @@ SUPERVISOR = REPO / "services" / "mft-supervisor"
 BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
 CONFIG = REPO / "config"
 SCENARIOS = CONFIG / "scenarios"
+_spec = importlib.util.spec_from_file_location("hop_table", REPO / "scripts" / "hop-table.py")
+_hop_module = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_hop_module)
+hop_table = _hop_module.hop_table  # scripts/hop-table.py: the per-hop split of a traced lockstep run
 # A domain block of its own per test process so that parallel CTest runs never meet.
 DOMAIN_BASE = 100 + (os.getpid() % 40) * 3
 
@@ -50,18 +55,18 @@ class StackTest(unittest.TestCase):
                 p.wait()
         shutil.rmtree(self.tmp, ignore_errors=True)
 
-    def supervisor(self, *args, timeout=240):
+    def supervisor(self, *args, timeout=240, env=None):
         cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
         if args[0] in ("run", "up"):
             cmd += ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        p = subprocess.Popen(cmd, env=env or self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.procs.append(p)
         out, err = p.communicate(timeout=timeout)
         return p.returncode, out, err
 
-    def run_json(self, scenario, domain, *extra):
+    def run_json(self, scenario, domain, *extra, env=None):
         code, out, err = self.supervisor("run", SCENARIOS / scenario, "--domain", domain, "--json",
-                                         "--run-dir", self.tmp / f"run-{domain}", *extra)
+                                         "--run-dir", self.tmp / f"run-{domain}", *extra, env=env)
         try:
             summary = json.loads(out)
         except ValueError:
@@ -69,7 +74,9 @@ class StackTest(unittest.TestCase):
         return code, summary, err
 
     def test_lockstep_steps_in_place_with_ticks_matching_on_every_topic(self):
-        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE)
+        hops = self.tmp / "hops"  # the per-hop trace of this run (docs/loop-benchmark.md), checked at the end
+        hops.mkdir()
+        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE, env=dict(self.env, MFT_HOP_TRACE=str(hops)))
         self.assertEqual(code, 0, err[-3000:])
         self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))
         self.assertEqual(s["ticks"], 10000)
@@ -84,6 +91,19 @@ class StackTest(unittest.TestCase):
         self.assertLess(sim["max_closure_error_m"], 1e-5)
         self.assertGreater(sim["touchdowns"][0], 5)          # it really steps
         self.assertLess(abs(sim["average_speed_mps"]), 0.05)
+        # The hop trace: every service stamped every tick, the stamps of the four processes are in causal order
+        # (no interval below zero), the intervals add up to the tick, and the WBC's interval holds its own tick.
+        table = hop_table(hops)
+        self.assertEqual(table["ticks"], 10000 - 100 - 1)  # all but the start-up ticks and the last
+        for row in table["intervals"]:
+            self.assertEqual(row["count"], table["ticks"], row["interval"])
+            self.assertGreaterEqual(row["min"], 0.0, row["interval"])
+        self.assertAlmostEqual(sum(r["mean"] for r in table["intervals"]), table["tick_us"]["mean"],
+                               delta=0.01 * table["tick_us"]["mean"])
+        wbc = next(r for r in table["intervals"] if r["interval"] == "WBC compute")
+        self.assertGreaterEqual(wbc["p50"], 0.9 * s["services"]["mft-wbc"]["tick_time_us"]["p50"])
+        print(f"\nlockstep per tick: mean {table['tick_us']['mean']:.0f} us, p50 {table['tick_us']['p50']:.0f} us; "
+              + ", ".join(f"{r['interval'].split(' ->')[0]} {r['p50']:.0f}" for r in table["intervals"]), file=sys.stderr)
 
     def test_realtime_steps_in_place(self):
         code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime", "--stall-probe")

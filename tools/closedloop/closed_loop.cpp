@@ -88,7 +88,8 @@ ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenari
     : configs_(configs),
       scenario_(scenario),
       options_(options),
-      terrain_(sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml")),
+      terrain_(options.terrain ? *options.terrain
+                               : sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml")),
       state_builder_(configs.robot),
       monitor_(criteriaOf(scenario), options.stats_from_s),
       recovery_(scenario.recovery.window_s, configs.sim.control_period_s) {

@@ -8,6 +8,7 @@
 // plan(k) -> reference(k) -> command(k) -> pushes armed by t_k -> sim.step() -> fall check on truth(k + 1).
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,9 @@ struct RunOptions {
   bool stop_at_fall = true;
   // Statistics (the summary below) are taken over [stats_from_s, end]; the RunMonitor's settle time too.
   double stats_from_s = 2.0;
+  // Replaces the scenario's terrain file (a diagnosis: e.g. the course with one obstacle removed, built from the
+  // course file in a test); unset = config_dir/terrain/<scenario.terrain>.yaml, as mft-sim loads it.
+  std::optional<sim::Terrain> terrain;
 };
 
 // Running figures over the statistics window (ground truth unless named estimator).

@@ -37,6 +37,8 @@ static int toolMain(int argc, char** argv) {
   cli.option("push", "a sagittal push on the torso [N s] (+ forward)");
   cli.option("push-at", "the push is armed at this time [s] and lands at the next right-foot lift-off", "5.0");
   cli.flag("push-timed", "apply the push at --push-at itself instead of at a lift-off");
+  cli.flag("no-scenario-profiles", "ignore the scenario file's profiles (e.g. the paper's setup on terrain-course, "
+           "whose file carries kv-0.145); --profile values still apply");
   cli.option("stance-width", "initial distance between the feet [m], right foot ahead (default: the scenario's "
              "initial_stance_width_m; without --scenario 0.12 with --stand, else 0)");
   cli.option("recovery-rule", "what counts as recovered from a push: stepping (back to stepping in place) | "
@@ -58,6 +60,7 @@ static int toolMain(int argc, char** argv) {
   try {
     if (cli.isSet("scenario")) {
       scenario = services::loadScenario(cli.get("scenario"));
+      if (cli.isSet("no-scenario-profiles")) scenario.profiles.clear();
     } else {
       const double h = cli.isSet("height") ? cli.getDouble("height", 0.1, 1.0) : 0.42;
       const double v = cli.isSet("speed") ? cli.getDouble("speed", -3.0, 3.0) : 0.0;

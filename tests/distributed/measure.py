@@ -15,37 +15,26 @@ DDS domains 230-232 (in the namespaces; the loopback reference run uses 232 in t
 import argparse
 import json
 import os
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
-
-from stack_layout import BIN, HOSTS, PLACEMENT, SCENARIOS, SUPERVISOR  # noqa: E402
+from stack_layout import HOSTS, PLACEMENT  # noqa: E402
+from mftstack.testing import StackRunner  # noqa: E402
 
 
 class Harness:
-    def __init__(self, tmp):
-        self.tmp = tmp
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(tmp / "runs"))
+    def __init__(self):
+        self.stacks = StackRunner(prefix="mft-distributed-measure-")
+        self.tmp = self.stacks.path
         self.n = 0
-        self.up_domains = set()
 
     def stop_all(self):
         """Stops every stack still up (after a failure), by the supervisor's `down`."""
-        for d in list(self.up_domains):
-            self.sup("down", "--domain", d)
-            self.up_domains.discard(d)
-
-    def sup(self, *args, timeout=240):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, timeout=timeout)
+        self.stacks.down_all()
 
     def network(self, domain):
         self.n += 1
@@ -56,44 +45,20 @@ class Harness:
 
     def up(self, net_stack, scenario, domain, *extra):
         net, stack = net_stack
-        self.up_domains.add(domain)
-        p = self.sup("up", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", "--stack", stack, *extra)
-        if p.returncode != 0:
-            log = self.tmp / "runs" / f"supervisor-d{domain}.log"
-            raise RuntimeError(p.stderr[-2000:] + (log.read_text()[-3000:] if log.exists() else ""))
-        return json.loads(self.sup("status", "--domain", domain, "--json").stdout)
+        return self.stacks.up(scenario, domain, "--mode", "realtime", "--stack", stack, *extra)
 
     def down(self, domain, st):
-        self.sup("down", "--domain", domain)
-        self.up_domains.discard(domain)
-        run_dir = Path(st["run_dir"])
-        return {n: json.loads((run_dir / f"{n}.summary.json").read_text())
-                for n in list(PLACEMENT) if (run_dir / f"{n}.summary.json").exists()}
+        return self.stacks.down(domain, st, names=PLACEMENT)
 
     def run(self, scenario, domain, *extra, during=None, stack=None):
         """A `run` to its end; `during(run_dir)` is called once the simulator is READY."""
         self.n += 1
-        run_dir = self.tmp / f"run-{self.n}"
-        args = ["run", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", "--json", "--run-dir", run_dir]
-        args += ["--stack", stack] if stack else []
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args + list(extra)] + ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        p = self.stacks.start_run(scenario, domain, "--mode", "realtime", *(["--stack", stack] if stack else []),
+                                  *extra, run_dir=self.tmp / f"run-{self.n}")
         if during:
-            deadline = time.monotonic() + 60
-            log = run_dir / "mft-sim.log"
-            while time.monotonic() < deadline and not (log.exists() and "READY mft-sim" in log.read_text()):
-                time.sleep(0.02)
-            during(run_dir)
-        try:
-            out, err = p.communicate(timeout=240)
-        finally:
-            if p.poll() is None:  # the supervisor stops its children
-                p.terminate()
-                p.wait(timeout=60)
-        try:
-            return json.loads(out)
-        except ValueError:
-            raise RuntimeError(f"no summary: {err[-2000:]}")
+            self.stacks.wait_for_text(p.run_dir / "mft-sim.log", "READY mft-sim")
+            during(p.run_dir)
+        return self.stacks.finish(p)[1]
 
 
 def sim_row(sim):
@@ -241,8 +206,7 @@ def main():
     if not ok:
         print(f"measure: network namespaces are not permitted here: {why}", file=sys.stderr)
         return 2
-    tmp = Path(tempfile.mkdtemp(prefix="mft-distributed-measure-"))
-    h = Harness(tmp)
+    h = Harness()
     out = {"load_before": os.getloadavg()}
     only = a.only.split(",")
     try:
@@ -256,9 +220,8 @@ def main():
         if "tbf" in only:
             measure_tbf(h, out, [float(x) for x in a.tbf.split(",")])
     finally:
-        h.stop_all()
+        h.stacks.close()
         out["load_after"] = os.getloadavg()
-        shutil.rmtree(tmp, ignore_errors=True)
     text = json.dumps(out, indent=1)
     if a.json:
         Path(a.json).write_text(text)

@@ -14,7 +14,6 @@ restart, refusal counters) and what was lost.
 
   scripts/fault-matrix.py [--bin-dir DIR] [--domain 200] [--out DIR] [--only REGEX] [--json]
 """
-import argparse
 import json
 import os
 import re
@@ -27,8 +26,8 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
-from mftstack.errors import run_script  # noqa: E402
-from mftstack.paths import DEFAULT_BIN, REPO, SUPERVISOR  # noqa: E402
+from mftstack.scripts import run_script, script_parser  # noqa: E402
+from mftstack.paths import REPO, SUPERVISOR  # noqa: E402
 from mftstack.testing import pid_alive  # noqa: E402
 
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
@@ -447,9 +446,7 @@ def markdown(rows, meta):
 
 
 def main():
-    p = argparse.ArgumentParser(prog="fault-matrix", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
-    p.add_argument("--bin-dir", default=str(DEFAULT_BIN))
+    p = script_parser("fault-matrix", __doc__)
     p.add_argument("--domain", type=int, default=200, help="DDS domain id for the stacks (default 200)")
     p.add_argument("--scenario", default="step-in-place", help="scenario name in config/scenarios (default step-in-place)")
     p.add_argument("--out", default=None, help="output folder (default runs/fault-matrix-<time>)")

@@ -7,7 +7,6 @@ test: the figures depend on the machine's load.
 
   scripts/measure-security.py [--bin-dir DIR] [--runs 2] [--profiles data,full] [--domain 205] [--json]
 """
-import argparse
 import json
 import os
 import shutil
@@ -18,8 +17,8 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
-from mftstack.errors import run_script  # noqa: E402
-from mftstack.paths import DEFAULT_BIN, REPO, SCENARIOS, SUPERVISOR  # noqa: E402
+from mftstack.scripts import run_script, script_parser  # noqa: E402
+from mftstack.paths import REPO, SCENARIOS, SUPERVISOR  # noqa: E402
 
 SCENARIO = SCENARIOS / "step-in-place.yaml"
 
@@ -49,9 +48,7 @@ def run(args, mode, secure, domain, tmp):
 
 
 def main():
-    p = argparse.ArgumentParser(prog="measure-security", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
-    p.add_argument("--bin-dir", default=str(DEFAULT_BIN))
+    p = script_parser("measure-security", __doc__)
     p.add_argument("--runs", type=int, default=2, help="runs per configuration and mode (median reported)")
     p.add_argument("--profiles", default="data,full", help="governance profiles to measure: data, full (comma list)")
     p.add_argument("--domain", type=int, default=205, help="DDS domain id (default 205)")

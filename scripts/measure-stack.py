@@ -18,7 +18,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
-from mftstack.errors import run_script  # noqa: E402
+from mftstack.scripts import run_script  # noqa: E402
 from mftstack.paths import DEFAULT_BIN, SCENARIOS, SUPERVISOR  # noqa: E402
 
 SCENARIO = SCENARIOS / "step-in-place.yaml"

@@ -39,7 +39,7 @@ from pathlib import Path
 
 from .checks import (DOMAIN_CHECKED_ENV, check_before_start, check_common, check_domain_range, check_record_target,
                      load_scenario)
-from .errors import Interrupted, SupervisorError, log, os_problem
+from .errors import Interrupted, SupervisorError, error_text, log
 from .paths import DEFAULT_BIN, DEFAULT_CONFIG, DEFAULT_RUNS
 from .processes import (ANSI_ESCAPE, READY_TIMEOUT_S, SECURE_RUN_ATTEMPTS, SECURE_START_TIMEOUT_S, STOP_GRACE_S, Stack,
                         pid_alive, read_json, tail, write_atomically)
@@ -60,6 +60,14 @@ def this_run_lines(path, offset, n):
     return "\n".join("    " + ANSI_ESCAPE.sub("", l) for l in lines[-n:])
 
 
+def stop_on_signals():
+    """A threading.Event that SIGTERM and SIGINT set: the stack is stopped in order instead of the process dying."""
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    return stop
+
+
 def cmd_run(args):
     check_common(args)
     scenario = load_scenario(args)
@@ -68,9 +76,7 @@ def cmd_run(args):
     else:
         check_before_start(args)
     error = None
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    stop = stop_on_signals()
     stack = Stack(args, scenario)
     stack.stop_flag = stop
     t0 = time.monotonic()
@@ -189,9 +195,7 @@ def cmd_up(args):
             time.sleep(0.1)
         raise SupervisorError("the stack did not come up in time")
     args.forever = True
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    stop = stop_on_signals()
     stack = Stack(args, scenario)
     stack.stop_flag = stop
     started = time.time()
@@ -350,15 +354,9 @@ def main(argv=None):
     except Interrupted as e:
         print(f"mft-supervisor: {e}: every service stopped", file=sys.stderr)
         return 130
-    except SupervisorError as e:
-        print(f"mft-supervisor: error: {e}", file=sys.stderr)
-        return 2
     except KeyboardInterrupt:
         print("mft-supervisor: interrupted before anything started", file=sys.stderr)
         return 130
-    except UnicodeDecodeError as e:
-        print(f"mft-supervisor: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        return 2
-    except OSError as e:
-        print(f"mft-supervisor: error: {os_problem(e)}", file=sys.stderr)
+    except (SupervisorError, UnicodeDecodeError, OSError) as e:
+        print(f"mft-supervisor: error: {error_text(e)}", file=sys.stderr)
         return 2

@@ -21,17 +21,10 @@ def os_problem(e):
     return f"{e.strerror or e}{where}"
 
 
-def run_script(main, name):
-    """sys.exit(main()) for a script or tool, with one line instead of a traceback for what a user can cause
-    (issue 16): Ctrl-C (exit status 130), an unwritable or full output folder, a file that is not UTF-8 (2)."""
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        print(f"{name}: interrupted", file=sys.stderr)
-        sys.exit(130)
-    except UnicodeDecodeError as e:
-        print(f"{name}: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        sys.exit(2)
-    except OSError as e:
-        print(f"{name}: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
-        sys.exit(2)
+def error_text(e):
+    """The one line after "error: " for a refusal, a file that is not UTF-8, or an OSError."""
+    if isinstance(e, UnicodeDecodeError):
+        return f"a file is not UTF-8 text (byte {e.start}: {e.reason})"
+    if isinstance(e, OSError):
+        return os_problem(e)
+    return str(e)

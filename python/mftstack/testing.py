@@ -11,13 +11,14 @@ import subprocess
 import sys
 import tempfile
 import time
+import unittest
 from pathlib import Path
 
 from .paths import DEFAULT_BIN as BIN
 from .paths import DEFAULT_CONFIG as CONFIG
 from .paths import REPO, SCENARIOS, SUPERVISOR
 
-__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "pid_alive"]
+__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "pid_alive"]
 
 
 def pid_alive(pid):
@@ -146,3 +147,15 @@ class StackRunner:
                 return
             time.sleep(0.02)
         raise AssertionError(f"'{text}' not in {path} within {timeout} s")
+
+
+class StackTestCase(unittest.TestCase):
+    """A test case with a StackRunner per test: self.stacks, self.tmp its folder; closed after tearDown
+    whatever happened (a tearDown that needs it closed earlier calls self.stacks.close(): it may run twice)."""
+
+    tmp_prefix = "mft-test-"
+
+    def setUp(self):
+        self.stacks = StackRunner(prefix=self.tmp_prefix)
+        self.tmp = self.stacks.path
+        self.addCleanup(self.stacks.close)

@@ -13,6 +13,7 @@ through mft-supervisor --stack, on its own namespaces:
 
 DDS domains 230-232 (in the namespaces; the loopback reference run uses 232 in the root namespace)."""
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -36,12 +37,18 @@ class Harness:
         """Stops every stack still up (after a failure), by the supervisor's `down`."""
         self.stacks.down_all()
 
+    @contextlib.contextmanager
     def network(self, domain):
+        """Three fresh namespace hosts and their stack file; afterwards every stack is down and they are gone."""
         self.n += 1
         net = TestNet.for_test(f"m{self.n}", HOSTS, domain).create()
         stack = self.tmp / f"stack-{self.n}.yaml"
         stack.write_text(net.stack_yaml(PLACEMENT))
-        return net, stack
+        try:
+            yield net, stack
+        finally:
+            self.stop_all()
+            net.destroy()
 
     def up(self, net_stack, scenario, domain, *extra):
         net, stack = net_stack
@@ -73,18 +80,14 @@ def sim_row(sim):
 def measure_bandwidth(h, out):
     rows = []
     for record in (False, True):
-        net, stack = h.network(230)
-        try:
+        with h.network(230) as (net, stack):
             extra = ["--record", h.tmp / "bw.rawlog"] if record else []
             st = h.up((net, stack), "step-in-place.yaml", 230, *extra)
             time.sleep(2.0)
             c0 = {x: net.counters(x) for x in HOSTS}
             time.sleep(5.0)
             c1 = {x: net.counters(x) for x in HOSTS}
-            s = h.down(230, st)
-        finally:
-            h.stop_all()
-            net.destroy()
+            h.down(230, st)
         for x in HOSTS:
             rows.append({"recorder": record, "host": x,
                          "tx_kBps": round((c1[x]["tx_bytes"] - c0[x]["tx_bytes"]) / 5e3, 1),
@@ -97,11 +100,8 @@ def measure_bandwidth(h, out):
     lat = []
     s = h.run("step-in-place.yaml", 232)
     lat.append(dict(where="one host (loopback, default)", **sim_row(s["services"]["mft-sim"])))
-    net, stack = h.network(232)
-    try:
+    with h.network(232) as (net, stack):
         s = h.run("step-in-place.yaml", 232, stack=stack)
-    finally:
-        net.destroy()
     lat.append(dict(where="three hosts (veth, initial peers)", **sim_row(s["services"]["mft-sim"])))
     for r in lat:
         print(f"latency {r['where']}: p50 {r['latency_p50_us']} p99 {r['latency_p99_us']} max {r['latency_max_us']}, "
@@ -112,20 +112,14 @@ def measure_bandwidth(h, out):
 def measure_loss(h, out, percents):
     rows = []
     for pct in percents:
-        net, stack = h.network(231)
-        drops = {}
+        with h.network(231) as (net, stack):
+            def during(run_dir):
+                with realtime_priority():
+                    for x in HOSTS:
+                        net.set_loss(x, pct)
 
-        def during(run_dir):
-            with realtime_priority():
-                for x in HOSTS:
-                    net.set_loss(x, pct)
-
-        try:
             s = h.run("step-in-place.yaml", 231, during=during if pct else None, stack=stack)
             drops = {x: net.loss_counters(x) for x in HOSTS}
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["services"]["mft-sim"]
         row = dict(loss_percent=pct, wbc_ticks=s["services"]["mft-wbc"]["ticks"], drops=drops, **sim_row(sim))
         row.pop("episodes")
@@ -140,16 +134,12 @@ def measure_cut(h, out, cuts_ms, scenarios=("stand.yaml",), long_cut_ms=None):
     if long_cut_ms:
         plan.append(("stand.yaml", long_cut_ms))
     for scenario, ms in plan:
-        net, stack = h.network(232)
-        try:
+        with h.network(232) as (net, stack):
             st = h.up((net, stack), scenario, 232)
             time.sleep(3.0)
             lo, hi = net.cut("ctrl", ms / 1000.0)
             time.sleep(3.0)
             s = h.down(232, st)
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["mft-sim"]
         ep = max(sim["damping_episodes"], key=lambda e: e[2]) if sim["damping_episodes"] else [0, 0, 0]
         silent = 3.0 + ep[1] + ep[2]
@@ -167,8 +157,7 @@ def measure_cut(h, out, cuts_ms, scenarios=("stand.yaml",), long_cut_ms=None):
 def measure_tbf(h, out, fractions):
     rows = []
     for frac in fractions:
-        net, stack = h.network(231)
-        try:
+        with h.network(231) as (net, stack):
             st = h.up((net, stack), "stand.yaml", 231)
             time.sleep(1.5)
             c0 = net.counters("robot")
@@ -183,9 +172,6 @@ def measure_tbf(h, out, fractions):
                 net.clear_rate("robot")
             time.sleep(2.0)
             s = h.down(231, st)
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["mft-sim"]
         row = dict(fraction=frac, need_kbit=round(need_kbit), rate_kbit=rate, tbf=tbf, **sim_row(sim))
         row["episodes"] = len(row["episodes"])

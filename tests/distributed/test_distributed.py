@@ -29,7 +29,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
 from stack_layout import HOSTS, PLACEMENT  # noqa: E402
 from mftstack.simlog import SimLog, run_tests  # noqa: E402
-from mftstack.testing import BIN, REPO, SCENARIOS, StackRunner  # noqa: E402
+from mftstack.testing import BIN, REPO, SCENARIOS, StackTestCase  # noqa: E402
 
 CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
 PERMITTED, WHY_NOT = netns_permitted()
@@ -45,10 +45,11 @@ def log(msg):
 
 @unittest.skipUnless(PERMITTED, f"distributed tests skipped: network namespaces are not permitted here ({WHY_NOT}); "
                                 "they need root with CAP_SYS_ADMIN, iproute2, nftables and tc")
-class DistributedTest(unittest.TestCase):
+class DistributedTest(StackTestCase):
+    tmp_prefix = "mft-distributed-test-"
+
     def setUp(self):
-        self.stacks = StackRunner(prefix="mft-distributed-test-")
-        self.tmp = self.stacks.path
+        super().setUp()
         self.nets = []
 
     def tearDown(self):

@@ -14,20 +14,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack import ddsxml, stackfile  # noqa: E402
 from mftstack.processes import ALL_SERVICES  # noqa: E402
 from mftstack.simlog import reserve_cpu_share  # noqa: E402
-from mftstack.testing import CONFIG, SCENARIOS, StackRunner  # noqa: E402
+from mftstack.testing import CONFIG, SCENARIOS, StackTestCase  # noqa: E402
 
 STACKS = CONFIG / "stacks"
 NS = "{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}"
 SERVICES = "services: {mft-sim: a, mft-wbc: b, mft-estimator: b, mft-planner: b}\n"
 
 
-class StackFileTest(unittest.TestCase):
-    def setUp(self):
-        self.stacks = StackRunner(prefix="mft-stackfile-test-")
-        self.tmp = self.stacks.path
-
-    def tearDown(self):
-        self.stacks.close()
+class StackFileTest(StackTestCase):
+    tmp_prefix = "mft-stackfile-test-"
 
     def write(self, text, name="stack.yaml"):
         path = self.tmp / name
@@ -69,23 +64,19 @@ class StackFileTest(unittest.TestCase):
             self.assertEqual(code, 2, (text, err))
             self.assertIn(expect, err, text)
             self.assertIn(str(stack.name), err)                      # the file is named
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", self.tmp / "nope.yaml")
-        self.assertEqual(code, 2)
-        self.assertIn("does not exist", err)
-        # A discovery server has no DDS Security identity: refused with --secure
-        stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
-                           "mft-planner: a}\ndiscovery: server\ndiscovery_server: {host: a}\n")
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack,
-                                         "--secure", self.tmp / "sec")
-        self.assertEqual(code, 2)
-        self.assertIn("discovery: server does not work with --secure", err)
-        # --record needs mft-record placed
-        stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
-                           "mft-planner: a}\n")
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack,
-                                         "--record", self.tmp / "r.rawlog")
-        self.assertEqual(code, 2)
-        self.assertIn("no host for mft-record", err)
+        one_host = "hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, mft-planner: a}\n"
+        refused_runs = [
+            (self.tmp / "nope.yaml", [], "does not exist"),
+            # A discovery server has no DDS Security identity: refused with --secure
+            (self.write(one_host + "discovery: server\ndiscovery_server: {host: a}\n", "server.yaml"),
+             ["--secure", self.tmp / "sec"], "discovery: server does not work with --secure"),
+            # --record needs mft-record placed
+            (self.write(one_host, "one.yaml"), ["--record", self.tmp / "r.rawlog"], "no host for mft-record"),
+        ]
+        for stack, extra, expect in refused_runs:
+            code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack, *extra)
+            self.assertEqual(code, 2, (stack, err))
+            self.assertIn(expect, err)
         self.assertFalse((self.tmp / "runs").exists(), "a run folder was created: something started")
 
     def test_shipped_stack_files_are_valid(self):

@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import SimLog, fifo_priority, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
-from mftstack.testing import BIN, StackRunner  # noqa: E402
+from mftstack.testing import BIN, StackTestCase  # noqa: E402
 DOMAIN = 225
 # Bound for a new participant to match the stack's endpoints (discovery on loopback takes well under 1 s on an
 # idle machine; the participant lease is 1 s, config/dds_profiles.xml): only a guard against a hang.
@@ -60,10 +60,12 @@ class Injector:
                                  f"{''.join(self.lines)[-2000:]}")
 
 
-class FaultTest(unittest.TestCase):
+class FaultTest(StackTestCase):
+    tmp_prefix = "mft-fault-test-"
+
     def setUp(self):
-        self.stacks = StackRunner(prefix="mft-fault-test-")
-        self.tmp, self.procs = self.stacks.path, self.stacks.procs  # mft-inject processes too
+        super().setUp()
+        self.procs = self.stacks.procs  # mft-inject processes too
         self.mounts, self.stopped = [], []
 
     def tearDown(self):
@@ -76,7 +78,6 @@ class FaultTest(unittest.TestCase):
         self.stacks.stop_processes()
         for m in self.mounts:  # unmounted once nothing writes there, before the folder holding them is removed
             subprocess.run(["umount", str(m)], capture_output=True)
-        self.stacks.close()
 
     def up(self, domain, *extra):
         return self.stacks.up("stand.yaml", domain, "--mode", "realtime", *extra)

@@ -12,19 +12,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import SimLog, reserve_cpu_share  # noqa: E402
-from mftstack.testing import CONFIG, SCENARIOS, StackRunner, pid_alive  # noqa: E402
+from mftstack.testing import CONFIG, SCENARIOS, StackTestCase, pid_alive  # noqa: E402
 
 # A domain block of its own per test process so that parallel CTest runs never meet.
 DOMAIN_BASE = 100 + (os.getpid() % 40) * 3
 
 
-class StackTest(unittest.TestCase):
-    def setUp(self):
-        self.stacks = StackRunner(prefix="mft-stack-test-")
-        self.tmp = self.stacks.path
-
-    def tearDown(self):
-        self.stacks.close()
+class StackTest(StackTestCase):
+    tmp_prefix = "mft-stack-test-"
 
     def test_lockstep_steps_in_place_with_ticks_matching_on_every_topic(self):
         code, s, err = self.stacks.run_json("step-in-place.yaml", DOMAIN_BASE)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import SimLog, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
-from mftstack.testing import BIN, REPO, SCENARIOS, StackRunner  # noqa: E402
+from mftstack.testing import BIN, REPO, SCENARIOS, StackTestCase  # noqa: E402
 
 MAKE = REPO / "scripts" / "make-security.sh"
 DOMAIN = 220
@@ -28,7 +28,9 @@ SECURE_MATCH_TIMEOUT_S = 10
 SECURE_MATCH_ATTEMPTS = 3
 
 
-class SecurityTest(unittest.TestCase):
+class SecurityTest(StackTestCase):
+    tmp_prefix = "mft-security-test-"
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = Path(tempfile.mkdtemp(prefix="mft-security-test-"))
@@ -44,11 +46,8 @@ class SecurityTest(unittest.TestCase):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
     def setUp(self):
-        self.stacks = StackRunner(prefix="mft-security-test-")
+        super().setUp()
         self.procs = self.stacks.procs  # mft-inject processes too: ended by close() whatever happens
-
-    def tearDown(self):
-        self.stacks.close()
 
     # ------------------------------------------------------------------------------------------ helpers
     def up(self, domain, scenario, *extra):

@@ -15,21 +15,22 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, CONFIG, SCENARIOS, StackRunner  # noqa: E402
+from mftstack.testing import BIN, CONFIG, SCENARIOS, StackTestCase  # noqa: E402
 
 DOMAIN_BASE = 140 + (os.getpid() % 20) * 3  # a block of its own, apart from the integration tests' 100-219
 
 
-class MisuseStackTest(unittest.TestCase):
+class MisuseStackTest(StackTestCase):
+    tmp_prefix = "mft-misuse-test-"
+
     def setUp(self):
-        self.stacks = StackRunner(prefix="mft-misuse-test-")
-        self.tmp, self.env = self.stacks.path, self.stacks.env
+        super().setUp()
+        self.env = self.stacks.env
         self.up_domains = []  # (domain, env) of background stacks to take down whatever happens
 
     def tearDown(self):
         for domain, env in self.up_domains:
             subprocess.run(self.stacks.command("down", "--domain", domain), env=env, capture_output=True, timeout=60)
-        self.stacks.close()
 
     def sup(self, *args, env=None, timeout=240):
         return subprocess.run(self.stacks.command(*args), env=env or self.env, capture_output=True, text=True,

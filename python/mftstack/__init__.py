@@ -7,6 +7,8 @@
   checks      everything checked before the first service starts
   summary     the run's summary: built, printed, written
   cli         mft-supervisor's commands (run, up, status, down, logs); services/mft-supervisor launches it
+  errors      the supervisor's errors and one-line messages
+  scripts     the measurement scripts' parser and one-line errors
   simlog      waiting on a running stack through its simulator's log (tests)
   testing     the one helper the tests run stacks with
 """

@@ -14,7 +14,6 @@ restart, refusal counters) and what was lost.
 
   scripts/fault-matrix.py [--bin-dir DIR] [--domain 200] [--out DIR] [--only REGEX] [--json]
 """
-import argparse
 import json
 import os
 import re
@@ -26,8 +25,11 @@ import tempfile
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
+from mftstack.scripts import run_script, script_parser  # noqa: E402
+from mftstack.paths import REPO, SUPERVISOR  # noqa: E402
+from mftstack.testing import pid_alive  # noqa: E402
+
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
 TOPICS = ["SensorData", "GroundTruth", "RobotState", "OperatorCommand", "Reference", "JointCommand",
           "WbcDiagnostics", "Disturbance"]
@@ -38,14 +40,6 @@ WATCHDOG_MS = 3.0
 def log(msg, quiet=False):
     if not quiet:
         print(f"fault-matrix: {msg}", file=sys.stderr, flush=True)
-
-
-def pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
-    except (OSError, IndexError):
-        return False
 
 
 def children(ppid, name):
@@ -452,9 +446,7 @@ def markdown(rows, meta):
 
 
 def main():
-    p = argparse.ArgumentParser(prog="fault-matrix", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
-    p.add_argument("--bin-dir", default=os.environ.get("MFT_BIN_DIR", str(REPO / "build" / "release" / "bin")))
+    p = script_parser("fault-matrix", __doc__)
     p.add_argument("--domain", type=int, default=200, help="DDS domain id for the stacks (default 200)")
     p.add_argument("--scenario", default="step-in-place", help="scenario name in config/scenarios (default step-in-place)")
     p.add_argument("--out", default=None, help="output folder (default runs/fault-matrix-<time>)")
@@ -501,16 +493,4 @@ def main():
 
 
 if __name__ == "__main__":
-    # One line instead of a traceback for what a user can cause (issue 16): Ctrl-C, an unwritable or full
-    # output folder, a file that is not UTF-8.
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        print("fault-matrix.py: interrupted", file=sys.stderr)
-        sys.exit(130)
-    except UnicodeDecodeError as e:
-        print(f"fault-matrix.py: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        sys.exit(2)
-    except OSError as e:
-        print(f"fault-matrix.py: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
-        sys.exit(2)
+    run_script(main, "fault-matrix.py")

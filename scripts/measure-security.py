@@ -7,7 +7,6 @@ test: the figures depend on the machine's load.
 
   scripts/measure-security.py [--bin-dir DIR] [--runs 2] [--profiles data,full] [--domain 205] [--json]
 """
-import argparse
 import json
 import os
 import shutil
@@ -17,9 +16,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-SCENARIO = REPO / "config" / "scenarios" / "step-in-place.yaml"
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
+from mftstack.scripts import run_script, script_parser  # noqa: E402
+from mftstack.paths import REPO, SCENARIOS, SUPERVISOR  # noqa: E402
+
+SCENARIO = SCENARIOS / "step-in-place.yaml"
 
 
 def run(args, mode, secure, domain, tmp):
@@ -47,9 +48,7 @@ def run(args, mode, secure, domain, tmp):
 
 
 def main():
-    p = argparse.ArgumentParser(prog="measure-security", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__.split("\n\n", 1)[1])
-    p.add_argument("--bin-dir", default=os.environ.get("MFT_BIN_DIR", str(REPO / "build" / "release" / "bin")))
+    p = script_parser("measure-security", __doc__)
     p.add_argument("--runs", type=int, default=2, help="runs per configuration and mode (median reported)")
     p.add_argument("--profiles", default="data,full", help="governance profiles to measure: data, full (comma list)")
     p.add_argument("--domain", type=int, default=205, help="DDS domain id (default 205)")
@@ -97,16 +96,4 @@ def main():
 
 
 if __name__ == "__main__":
-    # One line instead of a traceback for what a user can cause (issue 16): Ctrl-C, an unwritable or full
-    # output folder, a file that is not UTF-8.
-    try:
-        sys.exit(main())
-    except KeyboardInterrupt:
-        print("measure-security.py: interrupted", file=sys.stderr)
-        sys.exit(130)
-    except UnicodeDecodeError as e:
-        print(f"measure-security.py: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        sys.exit(2)
-    except OSError as e:
-        print(f"measure-security.py: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
-        sys.exit(2)
+    run_script(main, "measure-security.py")

@@ -18,9 +18,11 @@ import sys
 import tempfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-SCENARIO = REPO / "config" / "scenarios" / "step-in-place.yaml"
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
+from mftstack.scripts import run_script  # noqa: E402
+from mftstack.paths import DEFAULT_BIN, SCENARIOS, SUPERVISOR  # noqa: E402
+
+SCENARIO = SCENARIOS / "step-in-place.yaml"
 
 
 def progress(msg):
@@ -63,7 +65,7 @@ def run_stack(args, tmp, scenario, mode, record=False, tag="", hops=False):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=str(REPO / "build" / "release" / "bin"), help="service executables")
+    ap.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables")
     ap.add_argument("--domain", type=int, default=71, help="DDS domain id for the runs (default 71)")
     ap.add_argument("--runs", type=int, default=3, help="lockstep runs with and without recording (default 3)")
     ap.add_argument("--realtime-s", type=float, default=60.0, help="length of the realtime run [s] (default 60)")
@@ -145,16 +147,4 @@ def main():
 
 
 if __name__ == "__main__":
-    # One line instead of a traceback for what a user can cause (issue 16): Ctrl-C, an unwritable or full
-    # output folder, a file that is not UTF-8.
-    try:
-        main()
-    except KeyboardInterrupt:
-        print("measure-stack.py: interrupted", file=sys.stderr)
-        sys.exit(130)
-    except UnicodeDecodeError as e:
-        print(f"measure-stack.py: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        sys.exit(2)
-    except OSError as e:
-        print(f"measure-stack.py: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
-        sys.exit(2)
+    run_script(main, "measure-stack.py")

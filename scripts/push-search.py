@@ -25,12 +25,14 @@ import sys
 import tempfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
+from mftstack.scripts import run_script  # noqa: E402
+from mftstack.paths import DEFAULT_BIN, DEFAULT_CONFIG  # noqa: E402
 
 
 def config_for(model, substeps, tmp):
     d = Path(tmp) / model
-    shutil.copytree(REPO / "config", d)
+    shutil.copytree(DEFAULT_CONFIG, d)
     sim = d / "sim.yaml"
     text, n = re.subn(r"(?m)^  model: \w+", f"  model: {model}", sim.read_text())
     if substeps:
@@ -102,7 +104,7 @@ def spans(result):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default=str(REPO / "build" / "release" / "bin" / "mft-closedloop"))
+    ap.add_argument("--bin", default=str(DEFAULT_BIN / "mft-closedloop"))
     ap.add_argument("--models", default="sea,sea_motor")
     ap.add_argument("--controllers", default="mft,sa")
     ap.add_argument("--heights", default="0.40,0.42,0.44,0.46")
@@ -131,16 +133,4 @@ def main():
 
 
 if __name__ == "__main__":
-    # One line instead of a traceback for what a user can cause (issue 16): Ctrl-C, an unwritable or full
-    # output folder, a file that is not UTF-8.
-    try:
-        main()
-    except KeyboardInterrupt:
-        print("push-search.py: interrupted", file=sys.stderr)
-        sys.exit(130)
-    except UnicodeDecodeError as e:
-        print(f"push-search.py: error: a file is not UTF-8 text (byte {e.start}: {e.reason})", file=sys.stderr)
-        sys.exit(2)
-    except OSError as e:
-        print(f"push-search.py: error: {e.strerror or e}{': ' + str(e.filename) if e.filename else ''}", file=sys.stderr)
-        sys.exit(2)
+    run_script(main, "push-search.py")

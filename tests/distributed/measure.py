@@ -13,87 +13,59 @@ through mft-supervisor --stack, on its own namespaces:
 
 DDS domains 230-232 (in the namespaces; the loopback reference run uses 232 in the root namespace)."""
 import argparse
+import contextlib
 import json
 import os
-import shutil
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
-
-from stack_layout import BIN, HOSTS, PLACEMENT, SCENARIOS, SUPERVISOR  # noqa: E402
+from stack_layout import HOSTS, PLACEMENT  # noqa: E402
+from mftstack.testing import StackRunner  # noqa: E402
 
 
 class Harness:
-    def __init__(self, tmp):
-        self.tmp = tmp
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(tmp / "runs"))
+    def __init__(self):
+        self.stacks = StackRunner(prefix="mft-distributed-measure-")
+        self.tmp = self.stacks.path
         self.n = 0
-        self.up_domains = set()
 
     def stop_all(self):
         """Stops every stack still up (after a failure), by the supervisor's `down`."""
-        for d in list(self.up_domains):
-            self.sup("down", "--domain", d)
-            self.up_domains.discard(d)
+        self.stacks.down_all()
 
-    def sup(self, *args, timeout=240):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        return subprocess.run(cmd, env=self.env, capture_output=True, text=True, timeout=timeout)
-
+    @contextlib.contextmanager
     def network(self, domain):
+        """Three fresh namespace hosts and their stack file; afterwards every stack is down and they are gone."""
         self.n += 1
         net = TestNet.for_test(f"m{self.n}", HOSTS, domain).create()
         stack = self.tmp / f"stack-{self.n}.yaml"
         stack.write_text(net.stack_yaml(PLACEMENT))
-        return net, stack
+        try:
+            yield net, stack
+        finally:
+            self.stop_all()
+            net.destroy()
 
     def up(self, net_stack, scenario, domain, *extra):
         net, stack = net_stack
-        self.up_domains.add(domain)
-        p = self.sup("up", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", "--stack", stack, *extra)
-        if p.returncode != 0:
-            log = self.tmp / "runs" / f"supervisor-d{domain}.log"
-            raise RuntimeError(p.stderr[-2000:] + (log.read_text()[-3000:] if log.exists() else ""))
-        return json.loads(self.sup("status", "--domain", domain, "--json").stdout)
+        return self.stacks.up(scenario, domain, "--mode", "realtime", "--stack", stack, *extra)
 
     def down(self, domain, st):
-        self.sup("down", "--domain", domain)
-        self.up_domains.discard(domain)
-        run_dir = Path(st["run_dir"])
-        return {n: json.loads((run_dir / f"{n}.summary.json").read_text())
-                for n in list(PLACEMENT) if (run_dir / f"{n}.summary.json").exists()}
+        return self.stacks.down(domain, st, names=PLACEMENT)
 
     def run(self, scenario, domain, *extra, during=None, stack=None):
         """A `run` to its end; `during(run_dir)` is called once the simulator is READY."""
         self.n += 1
-        run_dir = self.tmp / f"run-{self.n}"
-        args = ["run", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", "--json", "--run-dir", run_dir]
-        args += ["--stack", stack] if stack else []
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args + list(extra)] + ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        p = self.stacks.start_run(scenario, domain, "--mode", "realtime", *(["--stack", stack] if stack else []),
+                                  *extra, run_dir=self.tmp / f"run-{self.n}")
         if during:
-            deadline = time.monotonic() + 60
-            log = run_dir / "mft-sim.log"
-            while time.monotonic() < deadline and not (log.exists() and "READY mft-sim" in log.read_text()):
-                time.sleep(0.02)
-            during(run_dir)
-        try:
-            out, err = p.communicate(timeout=240)
-        finally:
-            if p.poll() is None:  # the supervisor stops its children
-                p.terminate()
-                p.wait(timeout=60)
-        try:
-            return json.loads(out)
-        except ValueError:
-            raise RuntimeError(f"no summary: {err[-2000:]}")
+            self.stacks.wait_for_text(p.run_dir / "mft-sim.log", "READY mft-sim")
+            during(p.run_dir)
+        return self.stacks.finish(p)[1]
 
 
 def sim_row(sim):
@@ -108,18 +80,14 @@ def sim_row(sim):
 def measure_bandwidth(h, out):
     rows = []
     for record in (False, True):
-        net, stack = h.network(230)
-        try:
+        with h.network(230) as (net, stack):
             extra = ["--record", h.tmp / "bw.rawlog"] if record else []
             st = h.up((net, stack), "step-in-place.yaml", 230, *extra)
             time.sleep(2.0)
             c0 = {x: net.counters(x) for x in HOSTS}
             time.sleep(5.0)
             c1 = {x: net.counters(x) for x in HOSTS}
-            s = h.down(230, st)
-        finally:
-            h.stop_all()
-            net.destroy()
+            h.down(230, st)
         for x in HOSTS:
             rows.append({"recorder": record, "host": x,
                          "tx_kBps": round((c1[x]["tx_bytes"] - c0[x]["tx_bytes"]) / 5e3, 1),
@@ -132,11 +100,8 @@ def measure_bandwidth(h, out):
     lat = []
     s = h.run("step-in-place.yaml", 232)
     lat.append(dict(where="one host (loopback, default)", **sim_row(s["services"]["mft-sim"])))
-    net, stack = h.network(232)
-    try:
+    with h.network(232) as (net, stack):
         s = h.run("step-in-place.yaml", 232, stack=stack)
-    finally:
-        net.destroy()
     lat.append(dict(where="three hosts (veth, initial peers)", **sim_row(s["services"]["mft-sim"])))
     for r in lat:
         print(f"latency {r['where']}: p50 {r['latency_p50_us']} p99 {r['latency_p99_us']} max {r['latency_max_us']}, "
@@ -147,20 +112,14 @@ def measure_bandwidth(h, out):
 def measure_loss(h, out, percents):
     rows = []
     for pct in percents:
-        net, stack = h.network(231)
-        drops = {}
+        with h.network(231) as (net, stack):
+            def during(run_dir):
+                with realtime_priority():
+                    for x in HOSTS:
+                        net.set_loss(x, pct)
 
-        def during(run_dir):
-            with realtime_priority():
-                for x in HOSTS:
-                    net.set_loss(x, pct)
-
-        try:
             s = h.run("step-in-place.yaml", 231, during=during if pct else None, stack=stack)
             drops = {x: net.loss_counters(x) for x in HOSTS}
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["services"]["mft-sim"]
         row = dict(loss_percent=pct, wbc_ticks=s["services"]["mft-wbc"]["ticks"], drops=drops, **sim_row(sim))
         row.pop("episodes")
@@ -175,16 +134,12 @@ def measure_cut(h, out, cuts_ms, scenarios=("stand.yaml",), long_cut_ms=None):
     if long_cut_ms:
         plan.append(("stand.yaml", long_cut_ms))
     for scenario, ms in plan:
-        net, stack = h.network(232)
-        try:
+        with h.network(232) as (net, stack):
             st = h.up((net, stack), scenario, 232)
             time.sleep(3.0)
             lo, hi = net.cut("ctrl", ms / 1000.0)
             time.sleep(3.0)
             s = h.down(232, st)
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["mft-sim"]
         ep = max(sim["damping_episodes"], key=lambda e: e[2]) if sim["damping_episodes"] else [0, 0, 0]
         silent = 3.0 + ep[1] + ep[2]
@@ -202,8 +157,7 @@ def measure_cut(h, out, cuts_ms, scenarios=("stand.yaml",), long_cut_ms=None):
 def measure_tbf(h, out, fractions):
     rows = []
     for frac in fractions:
-        net, stack = h.network(231)
-        try:
+        with h.network(231) as (net, stack):
             st = h.up((net, stack), "stand.yaml", 231)
             time.sleep(1.5)
             c0 = net.counters("robot")
@@ -218,9 +172,6 @@ def measure_tbf(h, out, fractions):
                 net.clear_rate("robot")
             time.sleep(2.0)
             s = h.down(231, st)
-        finally:
-            h.stop_all()
-            net.destroy()
         sim = s["mft-sim"]
         row = dict(fraction=frac, need_kbit=round(need_kbit), rate_kbit=rate, tbf=tbf, **sim_row(sim))
         row["episodes"] = len(row["episodes"])
@@ -241,8 +192,7 @@ def main():
     if not ok:
         print(f"measure: network namespaces are not permitted here: {why}", file=sys.stderr)
         return 2
-    tmp = Path(tempfile.mkdtemp(prefix="mft-distributed-measure-"))
-    h = Harness(tmp)
+    h = Harness()
     out = {"load_before": os.getloadavg()}
     only = a.only.split(",")
     try:
@@ -256,9 +206,8 @@ def main():
         if "tbf" in only:
             measure_tbf(h, out, [float(x) for x in a.tbf.split(",")])
     finally:
-        h.stop_all()
+        h.stacks.close()
         out["load_after"] = os.getloadavg()
-        shutil.rmtree(tmp, ignore_errors=True)
     text = json.dumps(out, indent=1)
     if a.json:
         Path(a.json).write_text(text)

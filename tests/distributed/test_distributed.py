@@ -18,21 +18,19 @@ Skipped with a clear message where network namespaces cannot be made (not root, 
 DDS domains 230-232; each test runs in namespaces of its own (deleted in tearDown even on failure, every
 process stopped by pid through the supervisor's `down` or by its run's end)."""
 import json
-import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted, realtime_priority  # noqa: E402
+from stack_layout import HOSTS, PLACEMENT  # noqa: E402
+from mftstack.simlog import SimLog, run_tests  # noqa: E402
+from mftstack.testing import BIN, REPO, SCENARIOS, StackTestCase  # noqa: E402
 
-from stack_layout import BIN, HOSTS, PLACEMENT, REPO, SCENARIOS, SUPERVISOR  # noqa: E402
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, run_tests  # noqa: E402
 CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
 PERMITTED, WHY_NOT = netns_permitted()
 # Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/distributed.md):
@@ -47,28 +45,19 @@ def log(msg):
 
 @unittest.skipUnless(PERMITTED, f"distributed tests skipped: network namespaces are not permitted here ({WHY_NOT}); "
                                 "they need root with CAP_SYS_ADMIN, iproute2, nftables and tc")
-class DistributedTest(unittest.TestCase):
+class DistributedTest(StackTestCase):
+    tmp_prefix = "mft-distributed-test-"
+
     def setUp(self):
-        self.tmp = Path(tempfile.mkdtemp(prefix="mft-distributed-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
-        self.nets, self.up_domains, self.procs = [], [], []
+        super().setUp()
+        self.nets = []
 
     def tearDown(self):
-        for d in self.up_domains:  # a background stack left by a failed test: domain or (domain, host)
-            host = ["--host", d[1]] if isinstance(d, tuple) else []
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d[0] if host else d)] + host,
-                           env=self.env, capture_output=True, timeout=90)
-        for p in self.procs:
-            if p.poll() is None:
-                p.terminate()  # the supervisor stops its children (and they die with it: PDEATHSIG)
-                try:
-                    p.wait(timeout=30)
-                except subprocess.TimeoutExpired:
-                    p.kill()
-                    p.wait()
-        for net in self.nets:
-            net.destroy()
-        shutil.rmtree(self.tmp, ignore_errors=True)
+        try:
+            self.stacks.close()  # stacks and supervisors first, then their networks
+        finally:
+            for net in self.nets:
+                net.destroy()
 
     # ------------------------------------------------------------------------------------------ helpers
     def network(self, domain, discovery="initial_peers"):
@@ -88,54 +77,23 @@ class DistributedTest(unittest.TestCase):
         path.write_text(text.replace("duration_s: 10.0", f"duration_s: {duration_s}"))
         return path
 
-    def sup_cmd(self, *args):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        return cmd
-
     def run_start(self, scenario, domain, stack, *extra):
         """Starts `mft-supervisor run --json` in the background; returns (process, run folder)."""
-        run_dir = self.tmp / f"run-{domain}"
-        p = subprocess.Popen(self.sup_cmd("run", scenario, "--domain", domain, "--stack", stack, "--json",
-                                          "--run-dir", run_dir, *extra),
-                             env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.procs.append(p)
-        return p, run_dir
-
-    def run_finish(self, p, timeout=240):
-        out, err = p.communicate(timeout=timeout)
-        try:
-            s = json.loads(out)
-        except ValueError:
-            self.fail(f"no JSON summary (exit {p.returncode}): {err[-3000:]}")
-        return p.returncode, s, err
-
-    def wait_for_line(self, path, text, timeout=60):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if path.exists() and text in path.read_text(errors="replace"):
-                return
-            time.sleep(0.02)
-        self.fail(f"'{text}' not in {path} within {timeout} s")
+        p = self.stacks.start_run(scenario, domain, "--stack", stack, *extra, run_dir=self.tmp / f"run-{domain}")
+        return p, p.run_dir
 
     def up(self, scenario, domain, stack, *extra):
-        self.up_domains.append(domain)
-        p = subprocess.run(self.sup_cmd("up", scenario, "--domain", domain, "--stack", stack, *extra), env=self.env,
-                           capture_output=True, text=True, timeout=120)
-        self.assertEqual(p.returncode, 0, p.stderr[-3000:])
-        st = subprocess.run(self.sup_cmd("status", "--domain", domain, "--json"), env=self.env, capture_output=True,
-                            text=True, timeout=30)
-        return json.loads(st.stdout)
+        return self.stacks.up(scenario, domain, "--stack", stack, *extra)
 
     def down(self, domain, status):
-        p = subprocess.run(self.sup_cmd("down", "--domain", domain), env=self.env, capture_output=True, text=True,
-                           timeout=90)
-        self.up_domains.remove(domain)
-        self.assertEqual(p.returncode, 0, p.stderr)
-        run_dir = Path(status["run_dir"])
-        return {n: json.loads((run_dir / f"{n}.summary.json").read_text()) for n in PLACEMENT
-                if (run_dir / f"{n}.summary.json").exists() or n != "mft-record"}
+        return self.stacks.down(domain, status, names=PLACEMENT)
+
+    def assert_stepped_in_place(self, code, s, err, ticks):
+        self.assertEqual(code, 0, err[-3000:])
+        sim = s["services"]["mft-sim"]
+        self.assertFalse(s["fell"], sim.get("fall_reason"))
+        self.assertEqual(s["ticks"], ticks)
+        return sim
 
     def check_recorder_kept_what_it_received(self, rec, record_file):
         """Every sample the recorder received is in the file once: received = written + repeated (a re-sent
@@ -168,13 +126,10 @@ class DistributedTest(unittest.TestCase):
         before = {h: net.counters(h) for h in HOSTS}
         t0 = time.monotonic()
         p, run_dir = self.run_start(self.scenario("step-in-place.yaml"), domain, stack, "--record", record)
-        code, s, err = self.run_finish(p)
+        code, s, err = self.stacks.finish(p)
         wall = time.monotonic() - t0
         after = {h: net.counters(h) for h in HOSTS}
-        self.assertEqual(code, 0, err[-3000:])
-        sim = s["services"]["mft-sim"]
-        self.assertFalse(s["fell"], sim.get("fall_reason"))
-        self.assertEqual(s["ticks"], 10000)
+        sim = self.assert_stepped_in_place(code, s, err, 10000)
         for name in ("mft-estimator", "mft-planner", "mft-wbc"):
             self.assertEqual(s["services"][name]["ticks"], 10000, name)      # every tick answered once
             self.assertEqual(s["services"][name]["last_tick"], 9999, name)
@@ -196,16 +151,13 @@ class DistributedTest(unittest.TestCase):
         record = self.tmp / "loss.rawlog"
         p, run_dir = self.run_start(self.scenario("step-in-place.yaml"), domain, stack, "--mode", "realtime",
                                     "--record", record)
-        self.wait_for_line(run_dir / "mft-sim.log", "READY mft-sim")
+        self.stacks.wait_for_text(run_dir / "mft-sim.log", "READY mft-sim")
         with realtime_priority():
             for h in HOSTS:
                 net.set_loss(h, 1)
-        code, s, err = self.run_finish(p)
+        code, s, err = self.stacks.finish(p)
         drops = {h: net.loss_counters(h) for h in HOSTS}
-        self.assertEqual(code, 0, err[-3000:])
-        sim = s["services"]["mft-sim"]
-        self.assertFalse(s["fell"], sim.get("fall_reason"))
-        self.assertEqual(s["ticks"], 10000)
+        sim = self.assert_stepped_in_place(code, s, err, 10000)
         self.assertGreater(sum(d[0] for d in drops.values()), 100, drops)      # the loss was there
         self.assertGreater(sim["lost_commands"], 0, sim)                       # and the simulator saw it
         kept = self.check_recorder_kept_what_it_received(s["services"]["mft-record"], record)
@@ -258,11 +210,8 @@ class DistributedTest(unittest.TestCase):
         domain = 230
         net, stack = self.network(domain, discovery="server")
         p, run_dir = self.run_start(self.scenario("step-in-place.yaml", 5.0), domain, stack)
-        code, s, err = self.run_finish(p)
-        self.assertEqual(code, 0, err[-3000:])
-        sim = s["services"]["mft-sim"]
-        self.assertFalse(s["fell"], sim.get("fall_reason"))
-        self.assertEqual(s["ticks"], 5000)
+        code, s, err = self.stacks.finish(p)
+        sim = self.assert_stepped_in_place(code, s, err, 5000)
         for name in ("mft-estimator", "mft-planner", "mft-wbc"):
             self.assertEqual(s["services"][name]["ticks"], 5000, name)
         self.assertEqual(s["stack"]["discovery"], "server")
@@ -280,31 +229,18 @@ class DistributedTest(unittest.TestCase):
         scenario = self.scenario("step-in-place.yaml", 5.0)
         status = {}
         for host in ("aux", "ctrl"):
-            self.up_domains.append((domain, host))
-            p = subprocess.run(self.sup_cmd("up", scenario, "--domain", domain, "--stack", stack, "--host", host),
-                               env=self.env, capture_output=True, text=True, timeout=120)
-            self.assertEqual(p.returncode, 0, p.stderr[-3000:])
-            st = subprocess.run(self.sup_cmd("status", "--domain", domain, "--host", host, "--json"), env=self.env,
-                                capture_output=True, text=True, timeout=30)
-            status[host] = json.loads(st.stdout)
+            status[host] = self.stacks.up(scenario, domain, "--stack", stack, host=host)
         self.assertEqual(sorted(status["aux"]["services"]), ["mft-estimator", "mft-planner"])
         self.assertEqual(sorted(status["ctrl"]["services"]), ["mft-wbc"])
         p, run_dir = self.run_start(scenario, domain, stack, "--host", "robot")
-        code, s, err = self.run_finish(p)
-        self.assertEqual(code, 0, err[-3000:])
+        code, s, err = self.stacks.finish(p)
+        sim = self.assert_stepped_in_place(code, s, err, 5000)
         self.assertEqual(list(s["services"]), ["mft-sim"])
-        sim = s["services"]["mft-sim"]
-        self.assertFalse(s["fell"], sim.get("fall_reason"))
-        self.assertEqual(s["ticks"], 5000)
         ticks = {}
         for host in ("aux", "ctrl"):
-            p = subprocess.run(self.sup_cmd("down", "--domain", domain, "--host", host), env=self.env,
-                               capture_output=True, text=True, timeout=90)
-            self.up_domains.remove((domain, host))
-            self.assertEqual(p.returncode, 0, p.stderr)
-            for name in status[host]["services"]:
-                summary = json.loads((Path(status[host]["run_dir"]) / f"{name}.summary.json").read_text())
-                ticks[name] = summary["ticks"]
+            summaries = self.stacks.down(domain, status[host], names=status[host]["services"], host=host)
+            self.assertEqual(sorted(summaries), sorted(status[host]["services"]))
+            ticks.update({name: summary["ticks"] for name, summary in summaries.items()})
         self.assertEqual(ticks, {"mft-estimator": 5000, "mft-planner": 5000, "mft-wbc": 5000})
         log(f"\none supervisor per host (up --host aux, up --host ctrl, run --host robot), lockstep 5 s: no fall, "
             f"ticks answered {ticks}, sim wall {sim['wall_time_s']:.2f} s")
@@ -318,7 +254,7 @@ class DistributedTest(unittest.TestCase):
                            text=True, timeout=120)
         self.assertEqual(p.returncode, 0, p.stderr)
         p, run_dir = self.run_start(self.scenario("step-in-place.yaml", 5.0), domain, stack, "--secure", sec)
-        code, s, err = self.run_finish(p)
+        code, s, err = self.stacks.finish(p)
         self.assertEqual(code, 0, err[-3000:])
         self.assertTrue(s["secure"])
         self.assertFalse(s["fell"])
@@ -369,4 +305,4 @@ class DistributedTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    run_tests()  # nice -10, failures printed as they happen (tests/simlog.py)
+    run_tests()  # nice -10, failures printed as they happen (python/mftstack/simlog.py)

@@ -3,46 +3,26 @@
 (every error names the file and the key, nothing starts), the per-host DDS profiles it writes, and a short
 lockstep run of config/stacks/local.yaml (every service on 127.0.0.1 through the stack-file path, DDS
 domain 230 on loopback; the namespace tests use their own networks)."""
-import importlib.machinery
-import importlib.util
 import json
 import os
-import shutil
-import subprocess
 import sys
-import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack import ddsxml, stackfile  # noqa: E402
+from mftstack.processes import ALL_SERVICES  # noqa: E402
+from mftstack.simlog import reserve_cpu_share  # noqa: E402
+from mftstack.testing import CONFIG, SCENARIOS, StackTestCase  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
-STACKS = REPO / "config" / "stacks"
+STACKS = CONFIG / "stacks"
 NS = "{http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles}"
 SERVICES = "services: {mft-sim: a, mft-wbc: b, mft-estimator: b, mft-planner: b}\n"
 
 
-def load_supervisor():
-    loader = importlib.machinery.SourceFileLoader("mft_supervisor", str(SUPERVISOR))
-    spec = importlib.util.spec_from_loader("mft_supervisor", loader)
-    mod = importlib.util.module_from_spec(spec)
-    loader.exec_module(mod)
-    return mod
-
-
-class StackFileTest(unittest.TestCase):
-    def setUp(self):
-        self.tmp = Path(tempfile.mkdtemp(prefix="mft-stackfile-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
-        self.sup = load_supervisor()
-
-    def tearDown(self):
-        shutil.rmtree(self.tmp, ignore_errors=True)
+class StackFileTest(StackTestCase):
+    tmp_prefix = "mft-stackfile-test-"
 
     def write(self, text, name="stack.yaml"):
         path = self.tmp / name
@@ -50,9 +30,7 @@ class StackFileTest(unittest.TestCase):
         return path
 
     def supervisor(self, *args, timeout=120):
-        p = subprocess.run([sys.executable, str(SUPERVISOR)] + [str(a) for a in args] + ["--bin-dir", str(BIN)],
-                           env=self.env, capture_output=True, text=True, timeout=timeout)
-        return p.returncode, p.stdout, p.stderr
+        return self.stacks.supervisor(*args, timeout=timeout)
 
     def test_bad_stack_files_are_refused_before_anything_starts(self):
         hosts = "hosts: {a: {address: 127.0.0.1}, b: {address: 127.0.0.2}}\n"
@@ -86,57 +64,53 @@ class StackFileTest(unittest.TestCase):
             self.assertEqual(code, 2, (text, err))
             self.assertIn(expect, err, text)
             self.assertIn(str(stack.name), err)                      # the file is named
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", self.tmp / "nope.yaml")
-        self.assertEqual(code, 2)
-        self.assertIn("does not exist", err)
-        # A discovery server has no DDS Security identity: refused with --secure
-        stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
-                           "mft-planner: a}\ndiscovery: server\ndiscovery_server: {host: a}\n")
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack,
-                                         "--secure", self.tmp / "sec")
-        self.assertEqual(code, 2)
-        self.assertIn("discovery: server does not work with --secure", err)
-        # --record needs mft-record placed
-        stack = self.write("hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, "
-                           "mft-planner: a}\n")
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack,
-                                         "--record", self.tmp / "r.rawlog")
-        self.assertEqual(code, 2)
-        self.assertIn("no host for mft-record", err)
+        one_host = "hosts: {a: {address: 127.0.0.1}}\nservices: {mft-sim: a, mft-wbc: a, mft-estimator: a, mft-planner: a}\n"
+        refused_runs = [
+            (self.tmp / "nope.yaml", [], "does not exist"),
+            # A discovery server has no DDS Security identity: refused with --secure
+            (self.write(one_host + "discovery: server\ndiscovery_server: {host: a}\n", "server.yaml"),
+             ["--secure", self.tmp / "sec"], "discovery: server does not work with --secure"),
+            # --record needs mft-record placed
+            (self.write(one_host, "one.yaml"), ["--record", self.tmp / "r.rawlog"], "no host for mft-record"),
+        ]
+        for stack, extra, expect in refused_runs:
+            code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", 230, "--stack", stack, *extra)
+            self.assertEqual(code, 2, (stack, err))
+            self.assertIn(expect, err)
         self.assertFalse((self.tmp / "runs").exists(), "a run folder was created: something started")
 
     def test_shipped_stack_files_are_valid(self):
         for path in sorted(STACKS.glob("*.yaml")):
-            st = self.sup.load_stack(path, self.sup.ALL_SERVICES)
+            st = stackfile.load_stack(path, ALL_SERVICES)
             self.assertIn(st.discovery, ("initial_peers", "server"), path)
 
     def test_host_profiles(self):
         stack = self.write("hosts:\n  a: {address: 10.1.2.1, netns: nsa}\n  b: {address: 10.1.2.2}\n" + SERVICES)
-        st = self.sup.load_stack(stack, ["mft-sim", "mft-wbc", "mft-estimator", "mft-planner"])
+        st = stackfile.load_stack(stack, ["mft-sim", "mft-wbc", "mft-estimator", "mft-planner"])
         self.assertEqual(st.launcher("a"), ["ip", "netns", "exec", "nsa"])
         self.assertEqual(st.launcher("b"), [])
-        out = self.sup.write_host_profiles(st, REPO / "config", self.tmp)
+        out = ddsxml.write_host_profiles(st, CONFIG, self.tmp)
         root = ET.parse(out["b"]).getroot()
         self.assertEqual([a.text for a in root.iter(NS + "interfaceWhiteList") for a in a.iter(NS + "address")], ["10.1.2.2"])
         peers = root.find(f".//{NS}initialPeersList")
         self.assertEqual([a.text for a in peers.iter(NS + "address")], ["10.1.2.1", "10.1.2.2"])
-        self.assertEqual(root.find(f".//{NS}maxInitialPeersRange").text, str(self.sup.MAX_PARTICIPANTS_PER_HOST))
+        self.assertEqual(root.find(f".//{NS}maxInitialPeersRange").text, str(ddsxml.MAX_PARTICIPANTS_PER_HOST))
         # Everything else is the project's profile: the same QoS profiles.
         names = lambda r: sorted(e.get("profile_name") for e in r.iter() if e.get("profile_name"))
-        self.assertEqual(names(root), names(ET.parse(REPO / "config" / "dds_profiles.xml").getroot()))
+        self.assertEqual(names(root), names(ET.parse(CONFIG / "dds_profiles.xml").getroot()))
 
         stack = self.write("hosts:\n  a: {address: 10.1.2.1}\n  b: {address: 10.1.2.2}\n" + SERVICES +
                            "discovery: server\ndiscovery_server: {host: b, port: 11900}\n")
-        st = self.sup.load_stack(stack, ["mft-sim", "mft-wbc", "mft-estimator", "mft-planner"])
-        out = self.sup.write_host_profiles(st, REPO / "config", self.tmp)
+        st = stackfile.load_stack(stack, ["mft-sim", "mft-wbc", "mft-estimator", "mft-planner"])
+        out = ddsxml.write_host_profiles(st, CONFIG, self.tmp)
         root = ET.parse(out["a"]).getroot()
         self.assertIsNone(root.find(f".//{NS}initialPeersList"))
         self.assertEqual(root.find(f".//{NS}discoveryProtocol").text, "CLIENT")
         remote = root.find(f".//{NS}RemoteServer")
-        self.assertEqual(remote.get("prefix"), self.sup.DISCOVERY_SERVER_PREFIX)
+        self.assertEqual(remote.get("prefix"), ddsxml.DISCOVERY_SERVER_PREFIX)
         self.assertEqual([e.text for e in remote.iter(NS + "address")] + [e.text for e in remote.iter(NS + "port")],
                          ["10.1.2.2", "11900"])
-        server = ET.parse(out[self.sup.DISCOVERY_SERVER]).getroot()
+        server = ET.parse(out[ddsxml.DISCOVERY_SERVER]).getroot()
         self.assertEqual(server.find(f".//{NS}discoveryProtocol").text, "SERVER")
         self.assertEqual([a.text for a in server.iter(NS + "address")], ["10.1.2.2", "10.1.2.2"])  # whitelist, locator
 
@@ -158,5 +132,5 @@ class StackFileTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

@@ -32,10 +32,10 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 # A realtime stack under test runs at SCHED_FIFO 80 and delays an `ip`/`tc`/`nft` at normal priority by tens of
 # ms (once 1.2 s) on 2 busy cores, so a fault is applied inside this (SCHED_FIFO 85 where permitted).
-from simlog import fifo_priority as realtime_priority  # noqa: E402
+from mftstack.simlog import fifo_priority as realtime_priority  # noqa: E402
 
 IFACE = "eth0"
 NFT_TABLE = "mft_fault"

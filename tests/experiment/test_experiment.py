@@ -16,12 +16,11 @@ import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import reserve_cpu_share  # noqa: E402
+from mftstack.testing import BIN, REPO  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
 TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
 HEIGHT = "0.44"
 SWEEP = ["push-sweep", "--heights", HEIGHT, "--step", "1.0", "--max-impulse", "20", "--bin-dir", str(BIN)]
 
@@ -215,5 +214,5 @@ class ExperimentTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

@@ -4,18 +4,17 @@ is refused with one clear line and a documented exit status, fast, never an abor
 or a result that looks fine. Single processes only; the services are refused before they create a DDS
 participant (domain 231 if one ever did)."""
 import json
-import os
 import re
 import resource
 import shutil
 import subprocess
+import sys
 import tempfile
 import unittest
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent.parent
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-CONFIG = REPO / "config"
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.testing import BIN, CONFIG, REPO  # noqa: E402
 DEMO = CONFIG / "scenarios" / "demo.yaml"
 DOMAIN = "231"
 

@@ -9,23 +9,17 @@
 DDS domains 225-229; every process cleaned up through the supervisor's `down` (by pid) even on failure."""
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, fifo_priority, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
-
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import SimLog, fifo_priority, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
+from mftstack.testing import BIN, StackTestCase  # noqa: E402
 DOMAIN = 225
 # Bound for a new participant to match the stack's endpoints (discovery on loopback takes well under 1 s on an
 # idle machine; the participant lease is 1 s, config/dds_profiles.xml): only a guard against a hang.
@@ -37,7 +31,7 @@ class Injector:
     "counting from now" line (--wait-writers) before acting, and read its JSON report at the end."""
 
     def __init__(self, args):
-        # At SCHED_FIFO just below the stack (tests/simlog.py): the watch and the attack keep up with 1 kHz.
+        # At SCHED_FIFO just below the stack (python/mftstack/simlog.py): the watch and the attack keep up with 1 kHz.
         cmd = helper_realtime_prefix() + [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
         self.proc = subprocess.Popen(cmd,
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
@@ -66,11 +60,13 @@ class Injector:
                                  f"{''.join(self.lines)[-2000:]}")
 
 
-class FaultTest(unittest.TestCase):
+class FaultTest(StackTestCase):
+    tmp_prefix = "mft-fault-test-"
+
     def setUp(self):
-        self.tmp = Path(tempfile.mkdtemp(prefix="mft-fault-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
-        self.up_domains, self.procs, self.mounts, self.stopped = [], [], [], []
+        super().setUp()
+        self.procs = self.stacks.procs  # mft-inject processes too
+        self.mounts, self.stopped = [], []
 
     def tearDown(self):
         for pid in self.stopped:  # never leave a stopped process behind
@@ -78,35 +74,16 @@ class FaultTest(unittest.TestCase):
                 os.kill(pid, signal.SIGCONT)
             except OSError:
                 pass
-        for d in self.up_domains:
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
-                           capture_output=True, timeout=90)
-        for p in self.procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
-        for m in self.mounts:
+        self.stacks.down_all()
+        self.stacks.stop_processes()
+        for m in self.mounts:  # unmounted once nothing writes there, before the folder holding them is removed
             subprocess.run(["umount", str(m)], capture_output=True)
-        shutil.rmtree(self.tmp, ignore_errors=True)
-
-    def sup(self, *args, timeout=120):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] == "up":
-            cmd += ["--bin-dir", str(BIN)]
-        p = subprocess.run(cmd, env=self.env, capture_output=True, text=True, timeout=timeout)
-        return p.returncode, p.stdout, p.stderr
 
     def up(self, domain, *extra):
-        self.up_domains.append(domain)
-        code, out, err = self.sup("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode", "realtime", *extra)
-        self.assertEqual(code, 0, err[-2000:])
-        return json.loads(self.sup("status", "--domain", domain, "--json")[1])
+        return self.stacks.up("stand.yaml", domain, "--mode", "realtime", *extra)
 
     def down(self, domain, st, names=("mft-sim", "mft-wbc")):
-        code, out, err = self.sup("down", "--domain", domain, timeout=90)
-        self.up_domains.remove(domain)
-        self.assertEqual(code, 0, err)
-        return {n: json.loads((Path(st["run_dir"]) / f"{n}.summary.json").read_text()) for n in names}
+        return self.stacks.down(domain, st, names=names)
 
     def inject(self, *args):
         inj = Injector(args)
@@ -206,5 +183,5 @@ class FaultTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

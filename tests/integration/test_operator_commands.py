@@ -4,7 +4,6 @@ mft-cmd processes against a real stack started through services/mft-supervisor (
 on its own DDS domain (90-93), bounded in time, every process cleaned up even on failure. Needs MFT_BIN_DIR
 (set by CTest) pointing at the built executables."""
 import json
-import os
 import re
 import select
 import shutil
@@ -16,10 +15,9 @@ import time
 import unittest
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.testing import BIN, SCENARIOS, StackRunner  # noqa: E402
+
 DOMAIN_STACK, DOMAIN_EMPTY, DOMAIN_LATE = 90, 91, 92
 
 
@@ -41,20 +39,18 @@ class OperatorCommandsOnARunningStack(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.tmp = Path(tempfile.mkdtemp(prefix="mft-opcmd-test-"))
-        cls.env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
-        cls.run_dir = cls.tmp / "run"
+        cls.stacks = StackRunner(prefix="mft-opcmd-test-")
+        cls.run_dir = cls.stacks.path / "run"
         cls.sent = {"applied_commands": 0, "rejected_commands": 0, "pushes": []}
-        p = subprocess.run([sys.executable, str(SUPERVISOR), "up", str(SCENARIOS / "step-in-place.yaml"), "--domain",
-                            str(DOMAIN_STACK), "--mode", "realtime", "--run-dir", str(cls.run_dir), "--bin-dir", str(BIN)],
-                           env=cls.env, capture_output=True, text=True, timeout=180)
-        cls.up_error = None if p.returncode == 0 else f"supervisor up failed ({p.returncode}): {p.stderr[-2000:]}"
+        try:
+            cls.stacks.up("step-in-place.yaml", DOMAIN_STACK, "--mode", "realtime", "--run-dir", cls.run_dir, timeout=180)
+            cls.up_error = None
+        except AssertionError as e:
+            cls.up_error = str(e)
 
     @classmethod
     def tearDownClass(cls):
-        subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN_STACK)], env=cls.env,
-                       capture_output=True, timeout=60)
-        shutil.rmtree(cls.tmp, ignore_errors=True)
+        cls.stacks.close()
 
     def setUp(self):
         if self.up_error:
@@ -121,9 +117,7 @@ class OperatorCommandsOnARunningStack(unittest.TestCase):
         self.assertIn("push of 20.000 N s applied at t = ", applied["reason"])
 
     def test_5_the_stack_counted_every_command(self):
-        code = subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN_STACK)], env=self.env,
-                              capture_output=True, text=True, timeout=60).returncode
-        self.assertEqual(code, 0)
+        self.stacks.down(DOMAIN_STACK)
         planner = json.loads((self.run_dir / "mft-planner.summary.json").read_text())
         sim = json.loads((self.run_dir / "mft-sim.summary.json").read_text())
         ops = planner["operator_commands"]

@@ -3,26 +3,19 @@
 started through services/mft-supervisor, each test on its own DDS domain, bounded in time, every process
 cleaned up even on failure. Needs MFT_BIN_DIR (set by CTest) pointing at the built executables."""
 import importlib.util
-import json
 import os
 import shutil
 import signal
-import subprocess
 import sys
-import tempfile
 import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import SimLog, reserve_cpu_share  # noqa: E402
+from mftstack.testing import CONFIG, SCENARIOS, StackTestCase, pid_alive  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-CONFIG = REPO / "config"
-SCENARIOS = CONFIG / "scenarios"
-_spec = importlib.util.spec_from_file_location("hop_table", REPO / "scripts" / "hop-table.py")
+_spec = importlib.util.spec_from_file_location("hop_table", Path(__file__).resolve().parents[2] / "scripts" / "hop-table.py")
 _hop_module = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_hop_module)
 hop_table = _hop_module.hop_table  # scripts/hop-table.py: the per-hop split of a traced lockstep run
@@ -30,53 +23,14 @@ hop_table = _hop_module.hop_table  # scripts/hop-table.py: the per-hop split of 
 DOMAIN_BASE = 100 + (os.getpid() % 40) * 3
 
 
-def pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
-    except (ProcessLookupError, OSError):
-        return False
-
-
-class StackTest(unittest.TestCase):
-    def setUp(self):
-        self.tmp = Path(tempfile.mkdtemp(prefix="mft-stack-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
-        self.procs = []
-        self.domain_used = []
-
-    def tearDown(self):
-        for d in self.domain_used:  # a background stack left by a failed test
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
-                           capture_output=True, timeout=60)
-        for p in self.procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
-        shutil.rmtree(self.tmp, ignore_errors=True)
-
-    def supervisor(self, *args, timeout=240, env=None):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=env or self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.procs.append(p)
-        out, err = p.communicate(timeout=timeout)
-        return p.returncode, out, err
-
-    def run_json(self, scenario, domain, *extra, env=None):
-        code, out, err = self.supervisor("run", SCENARIOS / scenario, "--domain", domain, "--json",
-                                         "--run-dir", self.tmp / f"run-{domain}", *extra, env=env)
-        try:
-            summary = json.loads(out)
-        except ValueError:
-            self.fail(f"no JSON summary (exit {code}): {err[-3000:]}")
-        return code, summary, err
+class StackTest(StackTestCase):
+    tmp_prefix = "mft-stack-test-"
 
     def test_lockstep_steps_in_place_with_ticks_matching_on_every_topic(self):
-        hops = self.tmp / "hops"  # the per-hop trace of this run (docs/loop-benchmark.md), checked at the end
+        hops = self.stacks.path / "hops"  # the per-hop trace of this run (docs/loop-benchmark.md), checked at the end
         hops.mkdir()
-        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE, env=dict(self.env, MFT_HOP_TRACE=str(hops)))
+        code, s, err = self.stacks.run_json("step-in-place.yaml", DOMAIN_BASE,
+                                            env=dict(self.stacks.env, MFT_HOP_TRACE=str(hops)))
         self.assertEqual(code, 0, err[-3000:])
         self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))
         self.assertEqual(s["ticks"], 10000)
@@ -106,7 +60,7 @@ class StackTest(unittest.TestCase):
               + ", ".join(f"{r['interval'].split(' ->')[0]} {r['p50']:.0f}" for r in table["intervals"]), file=sys.stderr)
 
     def test_realtime_steps_in_place(self):
-        code, s, err = self.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime", "--stall-probe")
+        code, s, err = self.stacks.run_json("step-in-place.yaml", DOMAIN_BASE + 1, "--mode", "realtime", "--stall-probe")
         self.assertEqual(code, 0, err[-3000:])
         sim = s["services"]["mft-sim"]
         self.assertFalse(s["fell"], sim.get("fall_reason"))
@@ -136,12 +90,7 @@ class StackTest(unittest.TestCase):
 
     def test_killed_controller_puts_the_sim_into_damping_and_is_restarted(self):
         domain = DOMAIN_BASE + 2
-        self.domain_used.append(domain)
-        code, out, err = self.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode", "realtime",
-                                         timeout=120)
-        self.assertEqual(code, 0, err)
-        st = json.loads(subprocess.run([sys.executable, str(SUPERVISOR), "status", "--domain", str(domain), "--json"],
-                                       env=self.env, capture_output=True, text=True, timeout=30).stdout)
+        st = self.stacks.up("stand.yaml", domain, "--mode", "realtime")
         wbc_pid = st["services"]["mft-wbc"]["pid"]
         run_dir = Path(st["run_dir"])
         sim_log = SimLog(run_dir / "mft-sim.log")
@@ -156,11 +105,8 @@ class StackTest(unittest.TestCase):
         self.assertTrue(restarted, "the supervisor did not restart mft-wbc")
         # Commands flow again: a whole second of sim time without damping after the restart (not a fixed sleep).
         sim_log.wait_for_commands_flowing(sim_log.sim_time(), timeout=30)
-        code, out, err = self.supervisor("down", "--domain", domain, timeout=60)
-        self.domain_used.remove(domain)
-        self.assertEqual(code, 0, err)
+        sim = self.stacks.down(domain, st)["mft-sim"]
         self.assertFalse(pid_alive(wbc_pid))
-        sim = json.loads((run_dir / "mft-sim.summary.json").read_text())
         self.assertGreaterEqual(sim["deadline_misses"], 1)
         self.assertGreaterEqual(sim["watchdog_recoveries"], 1)   # back to normal commands after the restart
         self.assertGreater(sim["damping_ticks"], 0)
@@ -187,18 +133,18 @@ class StackTest(unittest.TestCase):
         ]
         for scenario, extra, expect in cases:
             args = ["run", scenario] + (extra or ["--domain", DOMAIN_BASE])
-            code, out, err = self.supervisor(*args, timeout=60)
+            code, out, err = self.stacks.supervisor(*args, timeout=60)
             self.assertEqual(code, 2, (scenario, err))
             self.assertIn(expect, err)
         cfg = self.tmp / "config"
         shutil.copytree(CONFIG, cfg)
         (cfg / "wbc.yaml").unlink()
-        code, out, err = self.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN_BASE, "--config-dir", cfg)
+        code, out, err = self.stacks.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN_BASE, "--config-dir", cfg)
         self.assertEqual(code, 2)
         self.assertIn("missing configuration", err)
         self.assertFalse((self.tmp / "runs").exists(), "a run folder was created: something started")
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

@@ -17,13 +17,10 @@ import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, fifo_priority, reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import SimLog, fifo_priority, reserve_cpu_share  # noqa: E402
+from mftstack.testing import BIN, CONFIG, StackRunner  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
 # Own domain block (the stack tests use 100..219): parallel CTest runs never meet.
 DOMAIN_BASE = 10 + (os.getpid() % 20) * 4
 TICK_LABELS = ["gt_q", "gt_qd", "contact_force", "leg_lti", "joint_q", "joint_qd", "joint_tau_meas", "imu",
@@ -41,60 +38,22 @@ def run(cmd, timeout=300, **kw):
     return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=timeout, **kw)
 
 
-class Tmp:
-    """One temporary folder and the supervisor runs of a test class, cleaned up whatever happens."""
-
-    def __init__(self):
-        self.path = Path(tempfile.mkdtemp(prefix="mft-rawlog-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.path / "runs"))
-        self.procs = []
-        self.domains_up = []
-
-    def supervisor(self, *args, timeout=300):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.procs.append(p)
-        out, err = p.communicate(timeout=timeout)
-        return p.returncode, out, err
-
-    def run_stack(self, domain, record=None, scenario="step-in-place.yaml"):
-        extra = ["--record", record] if record else []
-        code, out, err = self.supervisor("run", SCENARIOS / scenario, "--domain", domain, "--json",
-                                         "--run-dir", self.path / f"run-{domain}-{time.monotonic_ns()}", *extra)
-        try:
-            return code, json.loads(out), err
-        except ValueError:
-            raise AssertionError(f"no JSON summary (exit {code}): {err[-3000:]}")
-
-    def cleanup(self):
-        for d in self.domains_up:
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
-                           capture_output=True, timeout=60)
-        for p in self.procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
-        shutil.rmtree(self.path, ignore_errors=True)
-
-
 class RecordedLockstepRun(unittest.TestCase):
     """One 10 s lockstep run of step-in-place with --record, shared by the checks below."""
 
     @classmethod
     def setUpClass(cls):
-        cls.tmp = Tmp()
+        cls.tmp = StackRunner(prefix="mft-rawlog-test-")
         try:
             cls.rawlog = cls.tmp.path / "step.rawlog"
-            cls.code, cls.summary, cls.err = cls.tmp.run_stack(DOMAIN_BASE, record=cls.rawlog)
+            cls.code, cls.summary, cls.err = cls.tmp.run_json("step-in-place.yaml", DOMAIN_BASE, "--record", cls.rawlog)
         except BaseException:
-            cls.tmp.cleanup()
+            cls.tmp.close()
             raise
 
     @classmethod
     def tearDownClass(cls):
-        cls.tmp.cleanup()
+        cls.tmp.close()
 
     def info(self, path):
         p = run([BIN / "mft-export", path, "--info", "--json"])
@@ -158,7 +117,7 @@ class RecordedLockstepRun(unittest.TestCase):
         self.assertEqual(r["first_differing_tick"], -1)
         report("through_wbc", {"ticks": r["ticks_compared"], "max_abs_diff_Nm": r["max_abs_diff_Nm"]})
         # A controller change is caught: a different height-task weight.
-        wbc = (REPO / "config" / "wbc.yaml").read_text()
+        wbc = (CONFIG / "wbc.yaml").read_text()
         changed = re.sub(r"(?m)^(  base_z:\s*)1\.0\b", r"\g<1>1.5", wbc, count=1)
         self.assertNotEqual(changed, wbc)
         (self.tmp.path / "wbc-changed.yaml").write_text(changed)
@@ -255,7 +214,7 @@ class RecordedLockstepRun(unittest.TestCase):
         # The lockstep run is deterministic: recording must not change a single figure of it (it only adds
         # readers). The speed cost is reported here and measured properly by scripts/measure-stack.py
         # (speed targets live in measurements, not in timed tests; docs/benchmarks.md "Loop benchmark").
-        code, s, err = self.tmp.run_stack(DOMAIN_BASE + 2)
+        code, s, err = self.tmp.run_json("step-in-place.yaml", DOMAIN_BASE + 2)
         self.assertEqual(code, 0, err[-2000:])
         plain, recorded = s["services"]["mft-sim"], self.summary["services"]["mft-sim"]
         for key in ("ticks", "fell", "final_base_height_m", "average_speed_mps", "distance_m", "touchdowns",
@@ -271,20 +230,15 @@ class KilledRecorder(unittest.TestCase):
     but the last flush period, and the restarted recorder continues in a new piece."""
 
     def setUp(self):
-        self.tmp = Tmp()
+        self.tmp = StackRunner(prefix="mft-rawlog-test-")
 
     def tearDown(self):
-        self.tmp.cleanup()
+        self.tmp.close()
 
     def test_kill9_loses_at_most_200_ms(self):
         domain = DOMAIN_BASE + 3
         rawlog = self.tmp.path / "rt.rawlog"
-        self.tmp.domains_up.append(domain)
-        code, out, err = self.tmp.supervisor("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode",
-                                             "realtime", "--record", rawlog, timeout=120)
-        self.assertEqual(code, 0, err)
-        st = json.loads(run([sys.executable, SUPERVISOR, "status", "--domain", domain, "--json"],
-                            env=self.tmp.env).stdout)
+        st = self.tmp.up("stand.yaml", domain, "--mode", "realtime", "--record", rawlog)
         pid = st["services"]["mft-record"]["pid"]
         run_dir = Path(st["run_dir"])
         sim_log, rec_log = SimLog(run_dir / "mft-sim.log"), SimLog(run_dir / "mft-record.log")
@@ -294,9 +248,7 @@ class KilledRecorder(unittest.TestCase):
         rec_log.wait_for(lambda: rec_log.text().count("READY mft-record") >= 2, 20, "the recorder restarted (READY)")
         # The new piece must hold more than 500 ticks: wait for 2 s of sim time after the restart was ready.
         sim_log.wait_for_sim_time(sim_log.sim_time() + 2.0)
-        code, out, err = self.tmp.supervisor("down", "--domain", domain, timeout=60)
-        self.tmp.domains_up.remove(domain)
-        self.assertEqual(code, 0, err)
+        self.tmp.down(domain)
         p = run([BIN / "mft-export", rawlog, "--info", "--json"])
         self.assertEqual(p.returncode, 0, p.stderr)
         first = json.loads(p.stdout)
@@ -325,7 +277,7 @@ class StarvedRecorder(unittest.TestCase):
     the recorder and the file still has every tick."""
 
     def setUp(self):
-        self.tmp = Tmp()
+        self.tmp = StackRunner(prefix="mft-rawlog-test-")
         self.stopped = []
 
     def tearDown(self):
@@ -334,16 +286,13 @@ class StarvedRecorder(unittest.TestCase):
                 os.kill(pid, signal.SIGCONT)
             except OSError:
                 pass
-        self.tmp.cleanup()
+        self.tmp.close()
 
     def test_a_stopped_recorder_slows_the_run_and_loses_nothing(self):
         domain = DOMAIN_BASE + 2
         rawlog = self.tmp.path / "starved.rawlog"
         run_dir = self.tmp.path / "run-starved"
-        cmd = [sys.executable, str(SUPERVISOR), "run", str(SCENARIOS / "step-in-place.yaml"), "--domain", str(domain),
-               "--json", "--run-dir", str(run_dir), "--record", str(rawlog), "--bin-dir", str(BIN)]
-        sup = subprocess.Popen(cmd, env=self.tmp.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.tmp.procs.append(sup)
+        sup = self.tmp.start_run("step-in-place.yaml", domain, "--record", rawlog, run_dir=run_dir)
         # Wait until the recorder is recording, then take its CPU away for 1.5 s.
         rec_log, sim_log = SimLog(run_dir / "mft-record.log"), SimLog(run_dir / "mft-sim.log")
         rec_log.wait_for(lambda: "READY mft-record" in rec_log.text(), 60, "the recorder ready (READY)")
@@ -393,5 +342,5 @@ def tearDownModule():
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main()

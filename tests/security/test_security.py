@@ -4,7 +4,6 @@ from scripts/make-security.sh in a temporary directory) refuses participants wit
 writers without permission, and still steps in place. Real processes, DDS domains 220-224, bounded in time,
 every process cleaned up (by pid, through the supervisor's `down`) even on failure."""
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -12,17 +11,14 @@ import tempfile
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import SimLog, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import SimLog, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
+from mftstack.testing import BIN, REPO, SCENARIOS, StackTestCase  # noqa: E402
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
 MAKE = REPO / "scripts" / "make-security.sh"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-SCENARIOS = REPO / "config" / "scenarios"
 DOMAIN = 220
 # How long a new secured participant may take to match the stack's writers: the supervisor's own bound for a
-# secured chain to connect (SECURE_START_TIMEOUT_S in services/mft-supervisor), past which Fast DDS's handshake
+# secured chain to connect (SECURE_START_TIMEOUT_S in python/mftstack/processes.py), past which Fast DDS's handshake
 # is taken as stuck. On an idle machine it takes 0.3-1.2 s.
 SECURE_MATCH_TIMEOUT_S = 10
 # Fast DDS 2.9.1's handshake between two participants sometimes never completes (docs/security.md; seen here
@@ -32,7 +28,9 @@ SECURE_MATCH_TIMEOUT_S = 10
 SECURE_MATCH_ATTEMPTS = 3
 
 
-class SecurityTest(unittest.TestCase):
+class SecurityTest(StackTestCase):
+    tmp_prefix = "mft-security-test-"
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = Path(tempfile.mkdtemp(prefix="mft-security-test-"))
@@ -42,52 +40,24 @@ class SecurityTest(unittest.TestCase):
             p = subprocess.run(["bash", str(MAKE), str(d)], capture_output=True, text=True, timeout=120)
             if p.returncode != 0:
                 raise RuntimeError(f"make-security.sh failed: {p.stderr}")
-        cls.env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
     def setUp(self):
-        self.up_domains = []
-        self.procs = []
-
-    def tearDown(self):
-        for d in self.up_domains:
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(d)], env=self.env,
-                           capture_output=True, timeout=90)
-        for p in self.procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
+        super().setUp()
+        self.procs = self.stacks.procs  # mft-inject processes too: ended by close() whatever happens
 
     # ------------------------------------------------------------------------------------------ helpers
-    def sup(self, *args, timeout=240):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        p = subprocess.Popen(cmd, env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.procs.append(p)
-        out, err = p.communicate(timeout=timeout)
-        return p.returncode, out, err
-
     def up(self, domain, scenario, *extra):
-        self.up_domains.append(domain)
-        code, out, err = self.sup("up", SCENARIOS / scenario, "--domain", domain, "--mode", "realtime", *extra, timeout=120)
-        self.assertEqual(code, 0, err[-2000:])
-        code, out, err = self.sup("status", "--domain", domain, "--json", timeout=30)
-        return json.loads(out)
+        return self.stacks.up(scenario, domain, "--mode", "realtime", *extra)
 
     def down(self, domain, status):
-        code, out, err = self.sup("down", "--domain", domain, timeout=90)
-        self.up_domains.remove(domain)
-        self.assertEqual(code, 0, err)
-        run_dir = Path(status["run_dir"])
-        return {n: json.loads((run_dir / f"{n}.summary.json").read_text())
-                for n in ("mft-sim", "mft-wbc", "mft-estimator", "mft-planner")}
+        return self.stacks.down(domain, status)
 
     def inject(self, *args, timeout=60):
-        # At SCHED_FIFO just below the stack (tests/simlog.py): a listener's counts do not depend on the load.
+        # At SCHED_FIFO just below the stack (python/mftstack/simlog.py): a listener's counts do not depend on the load.
         cmd = helper_realtime_prefix() + [str(BIN / "mft-inject")] + [str(a) for a in args] + ["--json"]
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         self.procs.append(p)
@@ -182,7 +152,7 @@ class SecurityTest(unittest.TestCase):
 
     def test_secured_stack_steps_in_place_in_lockstep(self):
         run_dir = self.tmp / "run-lockstep"
-        code, out, err = self.sup("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
+        code, out, err = self.stacks.supervisor("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
                                   "--json", "--run-dir", run_dir)
         self.assertEqual(code, 0, err[-3000:] + "\nmft-sim.log:\n" + SimLog(run_dir / "mft-sim.log").text()[-3000:])
         s = json.loads(out)
@@ -196,13 +166,13 @@ class SecurityTest(unittest.TestCase):
         print(f"\nsecured lockstep step-in-place 10 s: wall {s['wall_time_s']} s", file=sys.stderr)
 
     def test_bad_security_directory_is_refused_before_anything_starts(self):
-        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", self.tmp / "nope")
+        code, out, err = self.stacks.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", self.tmp / "nope")
         self.assertEqual(code, 2)
         self.assertIn("is not a directory", err)
         partial = self.tmp / "partial"
         shutil.copytree(self.sec, partial)
         (partial / "permissions_wbc.p7s").unlink()
-        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", partial)
+        code, out, err = self.stacks.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", partial)
         self.assertEqual(code, 2)
         self.assertIn("permissions_wbc.p7s", err)
         # A service given another CA's identity with this CA's governance cannot even create its participant.
@@ -210,7 +180,7 @@ class SecurityTest(unittest.TestCase):
         shutil.copytree(self.sec, mixed)
         shutil.copy(self.rogue / "wbc.pem", mixed / "wbc.pem")
         shutil.copy(self.rogue / "wbc.key", mixed / "wbc.key")
-        code, out, err = self.sup("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", mixed, timeout=120)
+        code, out, err = self.stacks.supervisor("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN + 3, "--secure", mixed, timeout=120)
         self.assertNotEqual(code, 0)
         self.assertIn("mft-wbc", err)
 
@@ -226,5 +196,5 @@ class SecurityTest(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

@@ -10,44 +10,31 @@ import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 import unittest
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
-CONFIG = REPO / "config"
-SCENARIOS = CONFIG / "scenarios"
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.testing import BIN, CONFIG, SCENARIOS, StackTestCase  # noqa: E402
+
 DOMAIN_BASE = 140 + (os.getpid() % 20) * 3  # a block of its own, apart from the integration tests' 100-219
 
 
-def pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
-    except (ProcessLookupError, OSError):
-        return False
+class MisuseStackTest(StackTestCase):
+    tmp_prefix = "mft-misuse-test-"
 
-
-class MisuseStackTest(unittest.TestCase):
     def setUp(self):
-        self.tmp = Path(tempfile.mkdtemp(prefix="mft-misuse-test-"))
-        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.tmp / "runs"))
+        super().setUp()
+        self.env = self.stacks.env
         self.up_domains = []  # (domain, env) of background stacks to take down whatever happens
 
     def tearDown(self):
         for domain, env in self.up_domains:
-            subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(domain)], env=env,
-                           capture_output=True, timeout=60)
-        shutil.rmtree(self.tmp, ignore_errors=True)
+            subprocess.run(self.stacks.command("down", "--domain", domain), env=env, capture_output=True, timeout=60)
 
     def sup(self, *args, env=None, timeout=240):
-        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
-        if args[0] in ("run", "up"):
-            cmd += ["--bin-dir", str(BIN)]
-        return subprocess.run(cmd, env=env or self.env, capture_output=True, text=True, timeout=timeout)
+        return subprocess.run(self.stacks.command(*args), env=env or self.env, capture_output=True, text=True,
+                              timeout=timeout)
 
     def run_dirs(self, runs=None):
         runs = Path(runs or self.tmp / "runs")
@@ -160,8 +147,8 @@ class MisuseStackTest(unittest.TestCase):
                              res.stderr)
 
     def test_ctrl_c_right_at_spawn_stops_the_real_stack_promptly(self):
-        p = subprocess.Popen([sys.executable, str(SUPERVISOR), "run", str(SCENARIOS / "stand.yaml"), "--domain",
-                              str(DOMAIN_BASE + 2), "--bin-dir", str(BIN), "--run-dir", str(self.tmp / "run")],
+        p = subprocess.Popen(self.stacks.command("run", SCENARIOS / "stand.yaml", "--domain", DOMAIN_BASE + 2,
+                                                 "--run-dir", self.tmp / "run"),
                              env=self.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                              start_new_session=True)
         try:

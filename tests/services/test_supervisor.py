@@ -13,26 +13,13 @@ import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from simlog import reserve_cpu_share  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.simlog import reserve_cpu_share  # noqa: E402
+from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
 TOOLS = ["mft-participants"]  # the domain probe (the fake lists the participants of $FAKE_PARTICIPANTS)
-
-
-def pid_alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    # A zombie is dead for our purpose.
-    try:
-        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
-    except OSError:
-        return False
 
 
 class FakeStack:
@@ -45,7 +32,7 @@ class FakeStack:
         for s in SERVICES + TOOLS:
             (self.bin / s).symlink_to(HERE / "fake_service.py")
         self.cfg = self.tmp / "config"
-        shutil.copytree(REPO / "config", self.cfg, ignore=shutil.ignore_patterns("scenarios"))
+        shutil.copytree(CONFIG, self.cfg, ignore=shutil.ignore_patterns("scenarios"))
         for f in ("sim.yaml", "estimator.yaml", "planner.yaml", "wbc.yaml", "mft_space.yaml"):
             (self.cfg / f).touch()  # the fakes do not read them; the supervisor checks they exist
         self.scenario = self.tmp / "quick.yaml"
@@ -404,5 +391,5 @@ class MisuseTest(FakeStack, unittest.TestCase):
 
 
 if __name__ == "__main__":
-    reserve_cpu_share()  # a share of the CPU whatever else runs (tests/simlog.py)
+    reserve_cpu_share()  # a share of the CPU whatever else runs (python/mftstack/simlog.py)
     unittest.main(verbosity=2)

@@ -33,6 +33,15 @@ def load(csv_dir, label):
     return cols
 
 
+def save(fig, out, name):
+    """Writes the figure to out/name and frees it; returns the path."""
+    fig.tight_layout()
+    path = Path(out) / name
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def floating_base(csv_dir, out):
     gt, est = load(csv_dir, "gt_q"), load(csv_dir, "est_q")
     if not gt and not est:
@@ -46,11 +55,7 @@ def floating_base(csv_dir, out):
         ax.set_ylabel(f"base {key} [{unit}]")
     axes[0].legend(loc="best", frameon=False)
     axes[-1].set_xlabel("time [s]")
-    fig.tight_layout()
-    path = Path(out) / "floating_base.png"
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save(fig, out, "floating_base.png")
 
 
 def hip_angles(csv_dir, out):
@@ -64,11 +69,7 @@ def hip_angles(csv_dir, out):
     ax.set_xlabel("time [s]")
     ax.set_ylabel("hip angle [rad]")
     ax.legend(loc="best", frameon=False, ncol=2)
-    fig.tight_layout()
-    path = Path(out) / "hip_angles.png"
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save(fig, out, "hip_angles.png")
 
 
 def contact_forces(csv_dir, out):
@@ -82,11 +83,7 @@ def contact_forces(csv_dir, out):
         ax.set_ylabel(f"{comp} [N]")
     axes[0].legend(loc="best", frameon=False)
     axes[-1].set_xlabel("time [s]")
-    fig.tight_layout()
-    path = Path(out) / "contact_forces.png"
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save(fig, out, "contact_forces.png")
 
 
 def main():

@@ -9,10 +9,7 @@ import threading
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-DEFAULT_CONFIG = REPO / "config"
-DEFAULT_BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+from mftstack.paths import DEFAULT_BIN, DEFAULT_CONFIG, REPO, SUPERVISOR  # noqa: F401 (the tools' one place)
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
 
 # The paper's Table II (section IV-B): I_max [N s] per reference height, SA-WBC and MFT-WBC.

@@ -1,0 +1,161 @@
+"""The one helper the multi-process tests run stacks with (docs/testing.md "Running a stack in a test").
+
+StackRunner starts services/mft-supervisor the way a user does, in a temporary folder with a runs folder of its
+own (MFT_RUNS_DIR: state files and logs never meet another test's), and close() ends whatever it started,
+even after a failure: every `up` stack through the supervisor's `down` (by the pids in its state file), every
+supervisor process by its pid (SIGTERM, then SIGKILL; its services die with it, PR_SET_PDEATHSIG)."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from pathlib import Path
+
+from .paths import DEFAULT_BIN as BIN
+from .paths import DEFAULT_CONFIG as CONFIG
+from .paths import REPO, SCENARIOS, SUPERVISOR
+
+__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "pid_alive"]
+
+
+def pid_alive(pid):
+    """True while process pid runs; a zombie counts as dead (its parent has not reaped it yet)."""
+    try:
+        os.kill(pid, 0)
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+class StackRunner:
+    """mft-supervisor for a test: `run`, `up`, `status`, `down`, with the built executables (--bin-dir, and
+    --config-dir when given) added to `run` and `up`, and cleanup by close()."""
+
+    def __init__(self, prefix="mft-test-", bin_dir=BIN, config_dir=None):
+        self.path = Path(tempfile.mkdtemp(prefix=prefix))
+        self.env = dict(os.environ, MFT_RUNS_DIR=str(self.path / "runs"))
+        self.bin_dir, self.config_dir = bin_dir, config_dir
+        self.procs = []
+        self.up_domains = []  # domain, or (domain, host) for `up --host`
+
+    def command(self, *args):
+        cmd = [sys.executable, str(SUPERVISOR)] + [str(a) for a in args]
+        if args[0] in ("run", "up"):
+            cmd += ["--bin-dir", str(self.bin_dir)]
+            cmd += ["--config-dir", str(self.config_dir)] if self.config_dir else []
+        return cmd
+
+    def start(self, *args, env=None):
+        """The supervisor in the background (stdout, stderr: pipes of text); ended by close() if still running."""
+        p = subprocess.Popen(self.command(*args), env=env or self.env, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+        self.procs.append(p)
+        return p
+
+    def supervisor(self, *args, env=None, timeout=240):
+        """The supervisor to its end: (exit status, stdout, stderr)."""
+        p = self.start(*args, env=env)
+        out, err = p.communicate(timeout=timeout)
+        return p.returncode, out, err
+
+    def run_json(self, scenario, domain, *extra, run_dir=None, timeout=240, env=None):
+        """`run SCENARIO --domain D --json` (scenario: a file name in config/scenarios or a path), in run_dir
+        (default <tmp>/run-<domain>-<n>); returns (exit status, summary, stderr)."""
+        return self.finish(self.start_run(scenario, domain, *extra, run_dir=run_dir, env=env), timeout)
+
+    def start_run(self, scenario, domain, *extra, run_dir=None, env=None):
+        run_dir = run_dir or self.path / f"run-{domain}-{len(self.procs)}"
+        p = self.start("run", SCENARIOS / scenario, "--domain", domain, "--json", "--run-dir", run_dir, *extra, env=env)
+        p.run_dir = Path(run_dir)
+        return p
+
+    @staticmethod
+    def finish(p, timeout=240):
+        """Waits for a `run --json` started by start_run; (exit status, summary, stderr)."""
+        out, err = p.communicate(timeout=timeout)
+        try:
+            return p.returncode, json.loads(out), err
+        except ValueError:
+            raise AssertionError(f"no JSON summary (exit {p.returncode}): {err[-3000:]}")
+
+    def up(self, scenario, domain, *extra, host=None, timeout=120):
+        """`up` in the background, taken down by close(); returns its status (`status --json`)."""
+        self.up_domains.append((domain, host) if host else domain)
+        where = ["--host", host] if host else []
+        code, out, err = self.supervisor("up", SCENARIOS / scenario, "--domain", domain, *where, *extra,
+                                         timeout=timeout)
+        if code != 0:
+            log = self.path / "runs" / (f"supervisor-d{domain}-{host}.log" if host else f"supervisor-d{domain}.log")
+            raise AssertionError(f"mft-supervisor up failed (exit {code}): {err[-3000:]}"
+                                 + (f"\n{log}:\n{log.read_text(errors='replace')[-3000:]}" if log.exists() else ""))
+        return self.status(domain, host)
+
+    def status(self, domain, host=None):
+        code, out, err = self.supervisor("status", "--domain", domain, *(["--host", host] if host else []),
+                                         "--json", timeout=30)
+        try:
+            return json.loads(out)
+        except ValueError:
+            raise AssertionError(f"mft-supervisor status printed no JSON (exit {code}): {err[-2000:]}")
+
+    def down(self, domain, status=None, names=("mft-sim", "mft-wbc", "mft-estimator", "mft-planner"), host=None,
+             timeout=90):
+        """`down`; returns {service: its summary} of `names` from the run folder of `status` (those written)."""
+        code, out, err = self.supervisor("down", "--domain", domain, *(["--host", host] if host else []),
+                                         timeout=timeout)
+        self.up_domains.remove((domain, host) if host else domain)
+        if code != 0:
+            raise AssertionError(f"mft-supervisor down failed (exit {code}): {err[-2000:]}")
+        if status is None:
+            return {}
+        run_dir = Path(status["run_dir"])
+        return {n: json.loads((run_dir / f"{n}.summary.json").read_text()) for n in names
+                if (run_dir / f"{n}.summary.json").exists()}
+
+    def down_all(self):
+        """`down` of every stack still up (a test that failed before its own `down`), whatever it answers."""
+        for d in self.up_domains:
+            host = ["--host", d[1]] if isinstance(d, tuple) else []
+            subprocess.run(self.command("down", "--domain", d[0] if host else d, *host), env=self.env,
+                           capture_output=True, timeout=90)
+        self.up_domains = []
+
+    def close(self):
+        self.down_all()
+        self.stop_processes()
+        shutil.rmtree(self.path, ignore_errors=True)
+
+    def stop_processes(self):
+        """Ends every process in self.procs still running (the supervisor stops its children first)."""
+        for p in self.procs:
+            if p.poll() is None:
+                p.terminate()  # the supervisor stops its children (and they die with it: PDEATHSIG)
+                try:
+                    p.wait(timeout=30)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait()
+
+    def wait_for_text(self, path, text, timeout=60):
+        """Until `text` is in file `path` (a service log); fails with what was waited for."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if Path(path).exists() and text in Path(path).read_text(errors="replace"):
+                return
+            time.sleep(0.02)
+        raise AssertionError(f"'{text}' not in {path} within {timeout} s")
+
+
+class StackTestCase(unittest.TestCase):
+    """A test case with a StackRunner per test: self.stacks, self.tmp its folder; closed after tearDown
+    whatever happened (a tearDown that needs it closed earlier calls self.stacks.close(): it may run twice)."""
+
+    tmp_prefix = "mft-test-"
+
+    def setUp(self):
+        self.stacks = StackRunner(prefix=self.tmp_prefix)
+        self.tmp = self.stacks.path
+        self.addCleanup(self.stacks.close)

@@ -86,6 +86,13 @@ def snapshot_binaries(bin_dir, dest):
                 time.sleep(2.0)
         shutil.copy2(SUPERVISOR, tmp / "mft-supervisor")
         tmp.rename(dest)
+    # The supervisor's package beside the copied launcher (it looks in ../python first), frozen like the rest.
+    package = dest.parent / "python" / "mftstack"
+    if not package.is_dir():
+        tmp = package.with_name("mftstack.tmp")
+        shutil.rmtree(tmp, ignore_errors=True)
+        shutil.copytree(REPO / "python" / "mftstack", tmp, ignore=shutil.ignore_patterns("__pycache__"))
+        tmp.rename(package)
     SUPERVISOR = dest / "mft-supervisor"
     return dest
 

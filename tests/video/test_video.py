@@ -3,7 +3,8 @@
 the supervisor (real lockstep stack, DDS domains 6-9). The frames are decoded back with ffmpeg and checked
 from pixels: the hips and feet are discs of fixed colours centred where mft-export's kinematics put them
 (mapped to pixels with the renderer's own world-to-pixel transform, from --frame-log); the right leg has the
-colour of its MFT state; the push arrow is drawn at the push, which the base velocity jump confirms. Also
+colour of its MFT state; the ground line follows the test's own terrain (a board and a slope in view, in a
+test copy of the config folder); the push arrow is drawn at the push, which the base velocity jump confirms. Also
 the video's length, --speed, --from/--to, --beside and .gif, and every refused input (exit 2, nothing left
 behind). Needs MFT_BIN_DIR (set by CTest), ffmpeg and python3-matplotlib/numpy."""
 import json
@@ -51,7 +52,7 @@ description: Step in place at 0.42 m, MFT-WBC, a 3 N s push at the first right-f
 duration_s: 3.5
 controller: mft
 estimator: kalman
-terrain: flat
+terrain: video-test
 initial_base_height_m: 0.42
 fall:
   base_height_below_m: 0.25
@@ -64,6 +65,30 @@ pushes:
 """
 DURATION = 3.5
 IMPULSE = 3.0
+# Ground in view but out of the robot's way (it steps in place at x = 0): a 3 cm board from 0.35 to 0.55 m,
+# then a 6 degree slope from 0.6 to 1.0 m (config/terrain format; a test-only copy of the config folder).
+TERRAIN = """schema_version: 1
+start_x_m: 0.35
+start_height_m: 0.0
+terrain:
+  - {type: board, length_m: 0.2, height_m: 0.03}
+  - {type: flat, length_m: 0.05}
+  - {type: slope, length_m: 0.4, angle_deg: 6.0}
+  - {type: flat, length_m: 0.5}
+"""
+SLOPE_RISE = 0.4 * np.tan(np.radians(6.0))
+
+
+def ground_height(x):
+    """The test terrain's height, written out independently of sim/terrain.cpp."""
+    if 0.35 < x < 0.55:
+        return 0.03
+    if x <= 0.6:
+        return 0.0
+    return min(x - 0.6, 0.4) * np.tan(np.radians(6.0))
+
+
+GROUND_BREAKS = (0.35, 0.55, 0.6, 1.0)
 
 
 def run(cmd, timeout=600, **kw):
@@ -139,11 +164,14 @@ class Recorded(unittest.TestCase):
     def setUpClass(cls):
         cls.tmp = Path(tempfile.mkdtemp(prefix="mft-video-test-"))
         cls.rawlog = cls.tmp / "push.rawlog"
+        config = cls.tmp / "config"
+        shutil.copytree(REPO / "config", config)
+        (config / "terrain" / "video-test.yaml").write_text(TERRAIN)
         scenario = cls.tmp / "video-test.yaml"
         scenario.write_text(SCENARIO)
         env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
-        p = run([sys.executable, SUPERVISOR, "run", scenario, "--domain", DOMAIN, "--bin-dir", BIN, "--record",
-                 cls.rawlog, "--run-dir", cls.tmp / "run", "--json"], timeout=300, env=env)
+        p = run([sys.executable, SUPERVISOR, "run", scenario, "--domain", DOMAIN, "--bin-dir", BIN, "--config-dir",
+                 config, "--record", cls.rawlog, "--run-dir", cls.tmp / "run", "--json"], timeout=300, env=env)
         if p.returncode != 0 or not cls.rawlog.is_file():
             shutil.rmtree(cls.tmp, ignore_errors=True)
             raise AssertionError(f"recording the fixture run failed (exit {p.returncode}): {p.stderr[-2000:]}")
@@ -209,9 +237,33 @@ class Recorded(unittest.TestCase):
             v = np.max(self.leg_A @ np.array([self.gt_q[qr][i], self.gt_q[qf][i]]) - self.leg_b)
             if abs(v) > 1e-6:
                 self.assertEqual(leg["inside_mft"], bool(v <= 0), f"leg {k} at tick {panel['tick']}: max(Aq-b) = {v}")
-            # a foot carrying weight is on the ground (flat at z = 0, sunk by its contact spring only)
+            # a foot carrying weight is on the ground (sunk by its contact spring only)
             if self.force["fz_right" if k == 0 else "fz_left"][i] > 50:
-                self.assertLess(abs(leg["foot"][1]), 0.003, f"stance foot {k} at z = {leg['foot'][1]}")
+                self.assertLess(abs(leg["foot"][1] - ground_height(leg["foot"][0])), 0.003,
+                                f"stance foot {k} at {leg['foot']}")
+
+    def check_ground_pixels(self, frame, panel, tag):
+        """The ground line at the test terrain's height (board, slope), sky above it, ground fill below."""
+        x0, x1, _, _ = panel["view"]
+        line, fill, sky = (rgb(mft_video.COLORS[k]) for k in ("ground", "ground_fill", "sky"))
+        feet_x = [leg["foot"][0] for leg in panel["legs"]]
+        checked = 0
+        for x in np.arange(x0 + 0.02, x1 - 0.02, 0.013):
+            if min(abs(x - b) for b in GROUND_BREAKS) < 0.01 or abs(x - round(x, 1)) < 0.008 or \
+                    min(abs(x - f) for f in feet_x) < 0.05:
+                continue  # an edge, a tick mark, or a foot standing on the line
+            col, row = to_pixel(panel, (x, ground_height(x)))
+            c = int(col)
+            rows = [r for r in range(int(row) - 16, int(row) + 17)
+                    if np.all(np.abs(frame[r, c].astype(np.int16) - line) <= COLOUR_TOL)]
+            self.assertTrue(rows, f"{tag}: no ground line near row {row:.1f} at x = {x:.3f} m")
+            self.assertLess(abs(np.mean(rows) + 0.5 - row), CENTRE_TOL_PX, f"{tag}: ground line at x = {x:.3f} m "
+                                                                           f"drawn at row {np.mean(rows):.1f}, expected {row:.1f}")
+            self.assertTrue(np.all(np.abs(pixel_colour(frame, (col, row - 8)) - sky) <= COLOUR_TOL), f"{tag}: x = {x:.3f}")
+            self.assertTrue(np.all(np.abs(pixel_colour(frame, (col, row + 8)) - fill) <= COLOUR_TOL), f"{tag}: x = {x:.3f}")
+            checked += 1
+        self.assertGreater(checked, 60, f"{tag}: too few ground columns checked")
+        self.ground_columns += checked
 
     def test_1_frames_show_hips_and_feet_where_the_kinematics_puts_them(self):
         out, log = self.tmp / "window.mp4", self.tmp / "window.jsonl"
@@ -223,6 +275,7 @@ class Recorded(unittest.TestCase):
         self.assertEqual((w, h), tuple(frames[0]["size"]))
         self.assertAlmostEqual(duration, 2.0, delta=1.0 / 30)
         self.errors = []
+        self.ground_columns = 0
         decoded = 0
         push_frames = []
         for entry, frame in zip(frames, decoded_frames(out, w, h)):
@@ -230,6 +283,8 @@ class Recorded(unittest.TestCase):
             self.assertAlmostEqual(panel["t"], 1.5 + entry["i"] / 30.0, delta=0.0011)
             self.check_frame_log_against_recording(panel)
             self.check_robot_pixels(frame, panel, f"frame {entry['i']} (t = {panel['t']:.3f} s)")
+            if entry["i"] % 6 == 0:
+                self.check_ground_pixels(frame, panel, f"frame {entry['i']}")
             if panel["push_drawn"]:
                 push_frames.append(entry["i"])
                 tip = (panel["com"][0] - 0.14 - 0.5 * IMPULSE * mft_video.PUSH_M_PER_NS, panel["com"][1])
@@ -239,7 +294,8 @@ class Recorded(unittest.TestCase):
         self.assertEqual(decoded, 60)
         report("pixel_check", {"frames": decoded, "markers": len(self.errors),
                                "max_centre_error_px": round(max(self.errors), 3),
-                               "mean_centre_error_px": round(float(np.mean(self.errors)), 3)})
+                               "mean_centre_error_px": round(float(np.mean(self.errors)), 3),
+                               "ground_columns_checked": self.ground_columns})
         # The push: drawn from the foot-switch lift-off on; the base velocity jumps there.
         push = next(e["panels"][0]["push"] for e in frames if e["panels"][0]["push"])
         self.assertEqual(push["impulse_Ns"], IMPULSE)

@@ -278,6 +278,12 @@ class Progress:
     def update(self, done, final=False):
         el = time.monotonic() - self.t0
         rate = done / el if el > 0 else 0.0
+        if final:  # the recordings may end before the scenario's length (a fall): say what was done
+            if self.tty:
+                print("", file=sys.stderr)
+            print(f"mft-export: video done: {done} frames in {self.fmt(el)} ({rate:.1f} frames/s)", file=sys.stderr,
+                  flush=True)
+            return
         if self.expected > 0:
             frac = min(1.0, done / self.expected)
             bar = "#" * int(30 * frac) + "-" * (30 - int(30 * frac))
@@ -288,8 +294,8 @@ class Progress:
             frac = 0.0
             text = f"mft-export: video {done} frames, {rate:.1f} frames/s, elapsed {self.fmt(el)}"
         if self.tty:
-            print("\r" + text, end="\n" if final else "", file=sys.stderr, flush=True)
-        elif final or (self.expected > 0 and frac >= self.next_line) or (self.expected <= 0 and done % 300 == 0):
+            print("\r" + text, end="", file=sys.stderr, flush=True)
+        elif (self.expected > 0 and frac >= self.next_line) or (self.expected <= 0 and done % 300 == 0):
             print(text, file=sys.stderr, flush=True)
             while self.next_line <= frac:
                 self.next_line += 0.1

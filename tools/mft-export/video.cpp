@@ -219,11 +219,12 @@ class Panel {
     appendf(&s, "\"mft_space\": %s, \"duration_s\": %.6f, \"leg_reach_m\": %.6f, ", polytope_ ? "true" : "false",
             expectedDuration(), robot_.thigh.length_m + robot_.shank.length_m);
     appendf(&s, "\"terrain\": {\"name\": \"%s\", \"x\": [", jsonEscape(scenario_ ? scenario_->terrain : "flat").c_str());
-    // Breakpoints of the piecewise-linear profile, both sides of every step (board edges).
+    // Breakpoints of the piecewise-linear profile, just either side of every segment end, so a step (a board
+    // edge) is a vertical line and the flat ground before the first segment keeps its own height.
     std::vector<double> xs;
     constexpr double kEps = 1e-7;
     for (const auto& seg : terrain_.segments) {
-      xs.insert(xs.end(), {seg.x0, seg.x0 + kEps, seg.x1(), seg.x1() + kEps});
+      xs.insert(xs.end(), {seg.x0 - kEps, seg.x0 + kEps, seg.x1() - kEps, seg.x1() + kEps});
       for (std::size_t i = 1; i + 1 < seg.samples.size(); ++i) xs.push_back(seg.x0 + static_cast<double>(i) * seg.spacing);
     }
     if (xs.empty()) xs.push_back(terrain_.start_x);

@@ -11,6 +11,7 @@ PACKAGES=(
   libmrpt-obs-dev libmrpt-io-dev mrpt-apps
   libgtest-dev libgmock-dev libbenchmark-dev
   python3 python3-yaml python3-matplotlib
+  ffmpeg
   iproute2 nftables
   openssl
 )

@@ -1,5 +1,6 @@
 // mft-export: an mft rawlog to full-precision CSV (one file per label, named columns, %.17g), a summary of
-// what a file holds (--info), or paper-style figures (--plot: CSV + tools/mft-export/mft-plot.py).
+// what a file holds (--info), paper-style figures (--plot: CSV + tools/mft-export/mft-plot.py), or a video of
+// the robot as it moved (--video: video.cpp + tools/mft-export/mft-video.py, docs/videos.md).
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include "model/config/tool_io.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/runtime/process.hpp"
+#include "tools/mft-export/video.hpp"
 
 using namespace mft;
 namespace fs = std::filesystem;
@@ -55,9 +57,11 @@ int exportMain(int argc, char** argv) {
       "mft-export FILE",
       "Export an mft rawlog: --csv DIR writes <DIR>/<label>.csv (stamp_ns, time_s, then the named channels at\n"
       "full precision); --info summarises the file (labels, counts, ticks, how it ends); --plot DIR also draws\n"
-      "paper-style figures (floating base, hip angles, contact forces) with python3-matplotlib.\n"
+      "paper-style figures (floating base, hip angles, contact forces) with python3-matplotlib; --video OUT.mp4\n"
+      "(or .gif) draws the robot as it moved (legs through the five-bar kinematics, ground, contact forces, the\n"
+      "push, legs green inside / red outside the MFT preferable space), in real time unless --speed, with ffmpeg.\n"
       "Exit status: 0 ok (also for a truncated file, with a warning), 2 not an mft rawlog / other schema /\n"
-      "bad option, 4 corrupt (exported up to the damage).");
+      "bad option / output not writable / ffmpeg missing, 4 corrupt (exported up to the damage), 130 interrupted.");
   cli.option("file", "the rawlog (or give it as the first argument)");
   cli.option("csv", "write one CSV per label into this folder");
   cli.option("labels", "comma-separated labels to export (default: all)");
@@ -65,11 +69,24 @@ int exportMain(int argc, char** argv) {
   cli.option("plot", "write CSV into DIR/csv and figures (PNG) into DIR");
   cli.flag("metadata", "print the metadata comment (YAML) and exit");
   cli.flag("json", "print the summary as JSON");
+  cli.option("video", "write a video of the run to this .mp4 or .gif file (docs/videos.md)");
+  cli.option("beside", "with --video: a second rawlog drawn beside the first, on the same clock (e.g. the other "
+                       "controller's run of the same push)");
+  cli.option("speed", "with --video: simulated seconds per video second (default 1: real time; 0.25 = slow motion)");
+  cli.option("from", "with --video: first simulated time drawn [s] (default 0)");
+  cli.option("to", "with --video: last simulated time drawn [s] (default: the end of the recording)");
+  cli.option("fps", "with --video: frames per second of the video (default 30 for .mp4, 15 for .gif)");
+  cli.flag("overwrite", "with --video: replace an existing output file");
+  cli.option("frame-log", "with --video: also write, per frame, the drawn points and the world-to-pixel mapping "
+                          "as JSON lines to this file (tests)");
   cli.parse(argc, argv);
   if (file.empty()) file = cli.get("file");
   if (file.empty()) cli.fail("no rawlog given");
+  if (cli.isSet("video")) return video::videoMain(cli, file);
+  for (const char* video_only : {"beside", "speed", "from", "to", "fps", "overwrite", "frame-log"})
+    if (cli.isSet(video_only)) cli.fail(std::string("--") + video_only + " only applies to --video");
   if (!cli.isSet("csv") && !cli.isSet("info") && !cli.isSet("plot") && !cli.isSet("metadata"))
-    cli.fail("nothing to do: give --csv DIR, --plot DIR, --info or --metadata");
+    cli.fail("nothing to do: give --csv DIR, --plot DIR, --video OUT, --info or --metadata");
 
   std::unique_ptr<rawlog::RawlogReader> reader;
   try {

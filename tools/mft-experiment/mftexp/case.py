@@ -87,6 +87,9 @@ def cmd_case(args, setup):
             "wall_s": round(wall, 2)}
     png = plot_case(out / "case.png", args, setup, report, traces)
     report["fig67"] = str(plot_fig67(out / "case_fig67.png", args, setup, report, traces))
+    if args.video:
+        from .video import write_video
+        report["video"] = write_video(args, [out / f"{c}.rawlog" for c in args.controllers], out / "case.mp4")["video"]
     write_report(out / "case.json", report, png, t0, args.json)
     if not args.json:
         print(f"case: {args.impulse:g} N s {setup.direction} at {args.height:.2f} m ({setup.liftoff}-foot lift-off)")
@@ -94,6 +97,8 @@ def cmd_case(args, setup):
             print(f"  {CONTROLLER_NAMES.get(c, c):8s} push at {r['push_time_s']:.3f} s: "
                   f"{'RECOVERED' if r['recovered'] else 'NOT RECOVERED'} ({r['reason']})")
         print(f"  figures {png}, {report['fig67']}; rawlogs and CSV in {out}")
+        if report.get("video"):
+            print(f"  video {report['video']}")
     return 0
 
 

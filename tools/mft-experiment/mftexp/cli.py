@@ -6,7 +6,7 @@ import sys
 import time
 from pathlib import Path
 
-from . import push as _push, sweep as _sweep
+from . import push as _push, sweep as _sweep, video as _video
 from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, check_setup, log,
                      fmt_duration, snapshot_binaries)
 
@@ -14,8 +14,9 @@ HEIGHT_RANGE = (0.30, 0.46)
 DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the real multi-process stack, in lockstep.
 
   push-sweep  largest recovered impulse per base height and controller (Table II): table.md/.csv, push_sweep.png
-  case        one push with both controllers, the paper's Fig. 6 as a PNG
+  case        one push with both controllers, the paper's Fig. 6 as a PNG and a side-by-side video (case.mp4)
   terrain     blind walking over the course (board, slope, rough ground) with both controllers, Fig. 8 as a PNG
+              and a side-by-side video (terrain.mp4)
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
 
@@ -170,21 +171,24 @@ def build_parser():
 
     c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
                        description="One push at one height with both controllers (recorded), and the paper's "
-                                   "Fig. 6 as a PNG: hip joint angles of both legs; base height, pitch and speed.")
+                                   "Fig. 6 as a PNG: hip joint angles of both legs; base height, pitch and speed; "
+                                   "and both runs side by side as a video (case.mp4, docs/videos.md).")
     c.add_argument("--height", type=height, default=0.44, help="reference base height [m] (default 0.44)")
     c.add_argument("--impulse", type=positive, default=7.1, help="impulse [N s] (default 7.1, the paper's case)")
     c.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
     c.add_argument("--out", help="output folder (default runs/case-<time>)")
     add_push_setup(c)
     add_common(c)
+    _video.add_video_options(c)
 
     t = sub.add_parser("terrain", help="blind walking over the course with both controllers, the paper's Fig. 8",
                        description="Blind walking over config/terrain/<terrain>.yaml (3 cm board, 6 degree slope, "
                                    "about 2 cm rough ground) with both controllers, recorded. Success = the base "
                                    "passed the end of the course without a fall. Reports whether the left leg stayed "
                                    "inside the MFT preferable space (config/mft_space.yaml leg polygon) while in "
-                                   "stance on the up-slope, and draws the paper's Fig. 8. The runs carry the profile "
-                                   "kv-0.145, the one departure the slope needs (--paper-setup: none).")
+                                   "stance on the up-slope, and draws the paper's Fig. 8 and a side-by-side video (terrain.mp4). "
+                                   "The runs carry the profile kv-0.145, the one departure the slope needs "
+                                   "(--paper-setup: none).")
     t.add_argument("--speed", type=positive, default=0.25, help="commanded walking speed [m/s] (default 0.25)")
     t.add_argument("--height", type=height, default=0.42, help="reference base height [m] (default 0.42)")
     t.add_argument("--terrain", default="course", help="terrain file under config/terrain (default course)")
@@ -195,6 +199,7 @@ def build_parser():
                    help="without the profile kv-0.145 that the scenario otherwise carries (with the paper's k_v = 0.16 "
                         "the robot stalls on the slope; docs/experiments.md#terrain-fig-8)")
     add_common(t)
+    _video.add_video_options(t)
     from . import ablation as _abl
     a = sub.add_parser("ablation", help="each departure from the paper's setup alone; I_max against the slack weight",
                        description=_abl.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -156,6 +156,9 @@ def cmd_terrain(args):
             "average_speed_mps": sim.get("average_speed_mps"), "base_height_error_m": sim.get("base_height_error_m"),
             "left_stance_on_up_slope_mft": mft_check, "rawlog": str(out / f"{c}.rawlog"), "wall_s": round(wall, 1)}
     png = plot_terrain(out / "terrain.png", args, report, traces, segs, slopes, rows, b, verts)
+    if args.video:
+        from .video import write_video
+        report["video"] = write_video(args, [out / f"{c}.rawlog" for c in args.controllers], out / "terrain.mp4")["video"]
     write_report(out / "terrain.json", report, png, t0, args.json)
     if not args.json:
         print(f"terrain {args.terrain}: walk {args.speed} m/s at {args.height} m, course ends at x = {course_end:.2f} m; "
@@ -168,6 +171,8 @@ def cmd_terrain(args):
                   + ("" if not m else f"; left stance leg on the up-slope: {100 * m['inside_fraction']:.1f} % of "
                                       f"{m['samples']} samples inside the MFT space, max violation {m['max_violation_rad']:.3f} rad"))
         print(f"  figure {png}; rawlogs and CSV in {out}")
+        if report.get("video"):
+            print(f"  video {report['video']}")
     return 0
 
 

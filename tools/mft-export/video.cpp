@@ -1,0 +1,486 @@
+#include "tools/mft-export/video.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "model/config/tool_io.hpp"
+#include "model/mft_polytope.hpp"
+#include "model/robot_description.hpp"
+#include "services/record/rawlog_reader.hpp"
+#include "services/runtime/input_guard.hpp"
+#include "services/runtime/scenario.hpp"
+#include "sim/terrain.hpp"
+#include "tools/mft-export/robot_drawing.hpp"
+
+namespace mft::video {
+namespace {
+
+namespace fs = std::filesystem;
+using config::jsonEscape;
+
+constexpr int kExitBadInput = 2;
+constexpr int kExitCorrupt = 4;
+constexpr int kExitInterrupted = 130;
+// mft-sim refuses a Disturbance beyond --max-push (default 200 N s); such a request is not drawn as a push.
+constexpr double kSimMaxPushNs = 200.0;
+
+void appendf(std::string* s, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void appendf(std::string* s, const char* fmt, ...) {
+  char buf[512];
+  va_list ap;
+  va_start(ap, fmt);
+  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
+  va_end(ap);
+  if (n < 0) return;
+  if (static_cast<std::size_t>(n) < sizeof buf) {
+    s->append(buf, static_cast<std::size_t>(n));
+    return;
+  }
+  std::vector<char> big(static_cast<std::size_t>(n) + 1);
+  va_start(ap, fmt);
+  std::vsnprintf(big.data(), big.size(), fmt, ap);
+  va_end(ap);
+  s->append(big.data(), static_cast<std::size_t>(n));
+}
+
+void appendPoint(std::string* s, const char* key, const Eigen::Vector2d& p) {
+  appendf(s, "\"%s\": [%.9g, %.9g]", key, p.x(), p.y());
+}
+
+std::string controllerTitle(const std::string& c) {
+  if (c == "mft") return "MFT-WBC";
+  if (c == "sa") return "SA-WBC";
+  if (c == "none") return "WBC without MFT or SA terms";
+  return c.empty() ? "unknown controller" : c;
+}
+
+// A push as the simulator applies it: at a time, or at the first lift-off of a leg after it was armed.
+struct PushEvent {
+  double impulse_Ns = 0.0;
+  int leg = -1;           // -1: at armed_s itself; 0 right, 1 left: at that foot's next lift-off
+  double armed_s = 0.0;
+  bool applied = false;
+  double applied_s = 0.0;
+};
+
+// One recording and the state of its stream at the newest video frame.
+class Panel {
+ public:
+  explicit Panel(std::string path) : path_(std::move(path)) {}
+
+  // Reads the metadata and rebuilds what the drawing needs; false with *error set when it cannot.
+  bool open(std::string* error, std::vector<std::string>* warnings) {
+    try {
+      reader_ = std::make_unique<rawlog::RawlogReader>(path_);
+    } catch (const rawlog::NotMftRawlog& e) {
+      *error = std::string("refused: ") + e.what();
+      return false;
+    }
+    const auto& md = reader_->metadata();
+    assembler_ = std::make_unique<rawlog::MessageAssembler>(md.time_base_unix_ns);
+    auto text = [&](const std::string& name) -> const std::string* {
+      auto it = md.config.find(name);
+      return it == md.config.end() ? nullptr : &it->second;
+    };
+    const std::string* robot_text = text("robot.yaml");
+    if (!robot_text) {
+      *error = path_ + ": the recording has no robot.yaml in its metadata (needed to draw the robot)";
+      return false;
+    }
+    try {
+      robot_ = model::parseRobotDescription(*robot_text, "recorded robot.yaml");
+    } catch (const std::exception& e) {
+      *error = path_ + ": " + config::oneLine(e.what());
+      return false;
+    }
+    drawer_ = std::make_unique<RobotDrawer>(robot_);
+    if (const std::string* mft = text("mft_space.yaml")) {
+      try {
+        polytope_ = model::parseMftPolytope(*mft, "recorded mft_space.yaml", robot_);
+      } catch (const std::exception& e) {
+        warnings->push_back(path_ + ": legs not coloured by the MFT space: " + config::oneLine(e.what()));
+      }
+    } else {
+      warnings->push_back(path_ + ": no mft_space.yaml in the metadata: legs not coloured by the MFT space");
+    }
+    terrain_ = sim::Terrain::flat();
+    if (const std::string* scen = text("scenario")) {
+      try {
+        scenario_ = services::parseScenario(*scen, "recorded scenario");
+        for (const auto& p : scenario_->pushes) pushes_.push_back({p.impulse_Ns, p.at_liftoff_leg, p.at_s});
+        const std::string terrain_key = "terrain/" + scenario_->terrain + ".yaml";
+        if (const std::string* t = text(terrain_key)) terrain_ = sim::parseTerrain(*t, "recorded " + terrain_key);
+        else warnings->push_back(path_ + ": no " + terrain_key + " in the metadata: ground drawn flat at z = 0");
+      } catch (const std::exception& e) {
+        warnings->push_back(path_ + ": recorded scenario not usable (" + config::oneLine(e.what()) +
+                            "): no pushes drawn, ground drawn flat");
+        scenario_.reset();
+        pushes_.clear();
+        terrain_ = sim::Terrain::flat();
+      }
+    } else {
+      warnings->push_back(path_ + ": no scenario in the metadata: no pushes drawn, ground drawn flat");
+    }
+    return true;
+  }
+
+  const std::string& path() const { return path_; }
+  const rawlog::RawlogReader& reader() const { return *reader_; }
+  const rawlog::Metadata& metadata() const { return reader_->metadata(); }
+  // The scenario's length: what the progress bar expects (a run that fell ends earlier); 0 if unknown.
+  double expectedDuration() const { return scenario_ ? scenario_->duration_s : 0.0; }
+  bool hasSample() const { return have_gt_; }
+  bool atEnd() const { return at_end_; }
+  double sampleTime() const { return gt_t_; }
+
+  // Reads on until the first ground-truth sample at or after simulated time t (or the end of the file).
+  void advanceTo(double t) {
+    mrpt::obs::CObservation::Ptr obs;
+    rawlog::Message m;
+    std::int64_t unix_ns = 0;
+    while (!at_end_ && (!have_gt_ || gt_t_ < t - 1e-9)) {
+      if (!reader_->next(&obs)) {
+        at_end_ = true;
+        break;
+      }
+      if (!assembler_->add(*obs, &m, &unix_ns)) continue;
+      switch (rawlog::topicOf(m)) {
+        case rawlog::Topic::GroundTruth:
+          gt_ = std::get<msg::GroundTruth>(m);
+          gt_t_ = static_cast<double>(gt_.stamp_ns()) * 1e-9;
+          have_gt_ = true;
+          for (auto& p : pushes_)
+            if (!p.applied && p.leg < 0 && gt_t_ >= p.armed_s - 1e-9) {
+              p.applied = true;
+              p.applied_s = p.armed_s;
+            }
+          break;
+        case rawlog::Topic::SensorData: {
+          // The simulator applies an armed lift-off push in the physics step after the foot's contact ends;
+          // the foot switch is that contact state, so its 1 -> 0 edge is the push's tick (within 1 ms).
+          const auto& s = std::get<msg::SensorData>(m);
+          const double ts = static_cast<double>(s.stamp_ns()) * 1e-9;
+          for (int leg = 0; leg < 2; ++leg) {
+            const bool now = s.contact()[static_cast<std::size_t>(leg)];
+            if (have_contact_ && contact_[static_cast<std::size_t>(leg)] && !now)
+              for (auto& p : pushes_)
+                if (!p.applied && p.leg == leg && ts >= p.armed_s) {
+                  p.applied = true;
+                  p.applied_s = ts;
+                }
+            contact_[static_cast<std::size_t>(leg)] = now;
+          }
+          have_contact_ = true;
+          break;
+        }
+        case rawlog::Topic::Disturbance: {
+          // A push sent on the topic (mft-cmd --push): armed when it arrived (its stamp is the newest
+          // simulated time the recorder had seen), applied as the simulator does.
+          const auto& d = std::get<msg::Disturbance>(m);
+          if (services::checkDisturbance(d.impulse_Ns(), d.trigger(), d.time_s(), d.leg(), kSimMaxPushNs) !=
+              services::InputVerdict::Ok)
+            break;
+          const double arrived = static_cast<double>(unix_ns - metadata().time_base_unix_ns) * 1e-9;
+          if (d.trigger() == msg::TRIGGER_AT_TIME) pushes_.push_back({d.impulse_Ns(), -1, std::max(arrived, d.time_s())});
+          else pushes_.push_back({d.impulse_Ns(), d.leg(), arrived});
+          break;
+        }
+        default:
+          break;
+      }
+    }
+  }
+
+  // Everything the renderer needs once: names, the robot's size, the ground profile.
+  std::string headerJson() const {
+    const auto& md = metadata();
+    std::string s;
+    appendf(&s, "{\"file\": \"%s\", \"scenario\": \"%s\", \"controller\": \"%s\", \"title\": \"%s\", \"mode\": \"%s\", ",
+            jsonEscape(path_).c_str(), jsonEscape(md.scenario_name).c_str(), jsonEscape(md.controller).c_str(),
+            jsonEscape(controllerTitle(md.controller)).c_str(), jsonEscape(md.mode).c_str());
+    appendf(&s, "\"mft_space\": %s, \"duration_s\": %.6f, \"leg_reach_m\": %.6f, ", polytope_ ? "true" : "false",
+            expectedDuration(), robot_.thigh.length_m + robot_.shank.length_m);
+    appendf(&s, "\"terrain\": {\"name\": \"%s\", \"x\": [", jsonEscape(scenario_ ? scenario_->terrain : "flat").c_str());
+    // Breakpoints of the piecewise-linear profile, just either side of every segment end, so a step (a board
+    // edge) is a vertical line and the flat ground before the first segment keeps its own height.
+    std::vector<double> xs;
+    constexpr double kEps = 1e-7;
+    for (const auto& seg : terrain_.segments) {
+      xs.insert(xs.end(), {seg.x0 - kEps, seg.x0 + kEps, seg.x1() - kEps, seg.x1() + kEps});
+      for (std::size_t i = 1; i + 1 < seg.samples.size(); ++i) xs.push_back(seg.x0 + static_cast<double>(i) * seg.spacing);
+    }
+    if (xs.empty()) xs.push_back(terrain_.start_x);
+    std::sort(xs.begin(), xs.end());
+    for (std::size_t i = 0; i < xs.size(); ++i) appendf(&s, "%s%.9g", i ? ", " : "", xs[i]);
+    s += "], \"z\": [";
+    for (std::size_t i = 0; i < xs.size(); ++i) appendf(&s, "%s%.9g", i ? ", " : "", terrain_.heightAt(xs[i]));
+    s += "]}}";
+    return s;
+  }
+
+  // The current frame of this panel (the newest sample at or after the frame time, or the last one).
+  std::string frameJson(double t) const {
+    model::VectorQ q;
+    for (int i = 0; i < model::kNq; ++i) q[i] = gt_.q()[static_cast<std::size_t>(i)];
+    const RobotDrawing d = drawer_->draw(q);
+    std::string s;
+    appendf(&s, "{\"t\": %.6f, \"tick\": %llu, \"ended\": %s, \"base\": [%.9g, %.9g, %.9g], \"ground_z\": %.9g, ",
+            gt_t_, static_cast<unsigned long long>(gt_.tick()), at_end_ && gt_t_ < t - 1e-9 ? "true" : "false", d.base.x(), d.base.y(),
+            d.base.z(), terrain_.heightAt(d.base.x()));
+    s += "\"torso\": [";
+    for (std::size_t i = 0; i < d.torso.size(); ++i) appendf(&s, "%s[%.9g, %.9g]", i ? ", " : "", d.torso[i].x(), d.torso[i].y());
+    s += "], ";
+    appendPoint(&s, "com", d.torso_com);
+    s += ", \"legs\": [";
+    for (int leg = 0; leg < model::kNumLegs; ++leg) {
+      const auto& l = d.legs[static_cast<std::size_t>(leg)];
+      s += leg ? ", {" : "{";
+      appendPoint(&s, "hip_rear", l.hip_rear);
+      s += ", ";
+      appendPoint(&s, "hip_fore", l.hip_fore);
+      s += ", ";
+      appendPoint(&s, "knee_rear", l.knee_rear);
+      s += ", ";
+      appendPoint(&s, "knee_fore", l.knee_fore);
+      s += ", ";
+      appendPoint(&s, "foot", l.foot);
+      s += ", ";
+      appendPoint(&s, "foot_fore", l.foot_fore);
+      const double q_rear = q[model::hipRearIndex(leg)], q_fore = q[model::hipForeIndex(leg)];
+      const char* inside = !polytope_ ? "null" : polytope_->leg.contains(q_rear, q_fore) ? "true" : "false";
+      const auto li = static_cast<std::size_t>(leg);
+      appendf(&s, ", \"closed\": %s, \"inside_mft\": %s, \"lti\": %.6g, \"force\": [%.6g, %.6g]}",
+              l.closed_by_kinematics ? "true" : "false", inside, gt_.lti()[li], gt_.contact_force()[2 * li],
+              gt_.contact_force()[2 * li + 1]);
+    }
+    s += "], \"push\": ";
+    const PushEvent* latest = nullptr;
+    for (const auto& p : pushes_)
+      if (p.applied && p.applied_s <= gt_t_ + 1e-9 && (!latest || p.applied_s >= latest->applied_s)) latest = &p;
+    if (latest) appendf(&s, "{\"impulse_Ns\": %.6g, \"t\": %.6f}", latest->impulse_Ns, latest->applied_s);
+    else s += "null";
+    s += "}";
+    return s;
+  }
+
+ private:
+  std::string path_;
+  std::unique_ptr<rawlog::RawlogReader> reader_;
+  std::unique_ptr<rawlog::MessageAssembler> assembler_;
+  model::RobotDescription robot_;
+  std::unique_ptr<RobotDrawer> drawer_;
+  std::optional<model::MftPolytope> polytope_;
+  std::optional<services::Scenario> scenario_;
+  sim::Terrain terrain_;
+  std::vector<PushEvent> pushes_;
+  msg::GroundTruth gt_;
+  double gt_t_ = -1.0;
+  bool have_gt_ = false, at_end_ = false;
+  std::array<bool, 2> contact_{};
+  bool have_contact_ = false;
+};
+
+std::string lowerExtension(const std::string& path) {
+  std::string e = fs::path(path).extension().string();
+  std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return e;
+}
+
+// The first executable `name` on PATH ("" if none).
+std::string findOnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::stringstream ss(path ? path : "");
+  std::string dir;
+  while (std::getline(ss, dir, ':')) {
+    if (dir.empty()) continue;
+    const std::string candidate = dir + "/" + name;
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+  }
+  return "";
+}
+
+std::string seconds(double s) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3f s", s);
+  return buf;
+}
+
+std::string shellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+}  // namespace
+
+int videoMain(const services::CommandLine& cli, const std::string& file) {
+  const std::string out = cli.get("video");
+  const std::string ext = lowerExtension(out);
+  if (ext != ".mp4" && ext != ".gif") cli.fail("--video: " + out + " must end in .mp4 or .gif");
+  for (const char* other : {"csv", "plot", "info", "labels"})
+    if (cli.isSet(other)) cli.fail(std::string("--video cannot be combined with --") + other);
+  const double speed = cli.isSet("speed") ? cli.getDouble("speed", 0.01, 1000.0) : 1.0;
+  const long fps = cli.isSet("fps") ? cli.getInt("fps", 1, 120) : (ext == ".gif" ? 15 : 30);
+  const double from = cli.isSet("from") ? cli.getDouble("from", 0.0, 1e7) : 0.0;
+  const double to = cli.isSet("to") ? cli.getDouble("to", 0.0, 1e7) : INFINITY;
+  if (!(to > from)) cli.fail("--to must be after --from (got --from " + cli.get("from") + " --to " + cli.get("to") + ")");
+  std::error_code ec;
+  if (fs::is_directory(out, ec)) cli.fail("--video: " + out + " is a directory");
+  if (fs::exists(out, ec) && !cli.isSet("overwrite"))
+    cli.fail("--video: " + out + " already exists: refusing to replace it (--overwrite replaces it)");
+  const std::string ffmpeg = findOnPath("ffmpeg");
+  if (ffmpeg.empty()) {
+    std::fprintf(stderr, "mft-export: --video needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg)\n");
+    return kExitBadInput;
+  }
+  if (::access("/usr/bin/python3", X_OK) != 0) {
+    std::fprintf(stderr, "mft-export: --video needs /usr/bin/python3 with python3-matplotlib (Debian: apt-get install "
+                         "python3-matplotlib)\n");
+    return kExitBadInput;
+  }
+
+  std::vector<std::unique_ptr<Panel>> panels;
+  std::vector<std::string> warnings;
+  panels.push_back(std::make_unique<Panel>(file));
+  if (cli.isSet("beside")) panels.push_back(std::make_unique<Panel>(cli.get("beside")));
+  for (auto& p : panels) {
+    std::string error;
+    if (!p->open(&error, &warnings)) {
+      std::fprintf(stderr, "mft-export: %s\n", error.c_str());
+      return kExitBadInput;
+    }
+  }
+  double expected_end = 0.0;
+  for (const auto& p : panels) expected_end = std::max(expected_end, p->expectedDuration());
+  if (expected_end > 0.0 && from >= expected_end)
+    cli.fail("--from " + cli.get("from") + " s is not before the end of the run (" + seconds(expected_end) + ")");
+  for (const auto& w : warnings) std::fprintf(stderr, "mft-export: warning: %s\n", w.c_str());
+
+  // Written under a temporary name in the same folder and renamed when complete: an interrupted or failed
+  // render never leaves a partial video under the requested name.
+  const fs::path out_path(out);
+  const fs::path dir = out_path.has_parent_path() ? out_path.parent_path() : fs::path(".");
+  const std::string tmp = (dir / ("." + out_path.filename().string() + ".partial-" + std::to_string(::getpid()))).string();
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) {
+    std::fprintf(stderr, "mft-export: cannot write %s: %s\n", out.c_str(), std::strerror(errno));
+    return kExitBadInput;
+  }
+  ::close(fd);
+  auto removeTmp = [&] { ::unlink(tmp.c_str()); };
+
+  const double frame_dt = speed / static_cast<double>(fps);
+  const double end_for_estimate = std::min(to, expected_end);
+  // A recording of D s holds samples up to D - 1 ms: frames at from + i dt for from + i dt < D.
+  const long frames_expected =
+      end_for_estimate > from ? static_cast<long>(std::ceil((end_for_estimate - from) / frame_dt - 1e-6)) : 0;
+  std::string header;
+  appendf(&header, "{\"type\": \"header\", \"output\": \"%s\", \"final_output\": \"%s\", \"format\": \"%s\", \"ffmpeg\": \"%s\", ",
+          jsonEscape(tmp).c_str(), jsonEscape(out).c_str(), ext.substr(1).c_str(), jsonEscape(ffmpeg).c_str());
+  appendf(&header, "\"fps\": %ld, \"speed\": %.9g, \"from_s\": %.9g, \"frames_expected\": %ld, \"frame_log\": \"%s\", \"panels\": [",
+          fps, speed, from, frames_expected, jsonEscape(cli.get("frame-log")).c_str());
+  for (std::size_t i = 0; i < panels.size(); ++i) header += (i ? ", " : "") + panels[i]->headerJson();
+  header += "]}\n";
+
+  // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/videos.md).
+  std::signal(SIGPIPE, SIG_IGN);  // a renderer that died shows as a failed write, not as our death
+  services::installShutdownHandlers();
+  const std::string cmd = "/usr/bin/python3 " + shellQuote(MFT_VIDEO_SCRIPT);
+  std::FILE* renderer = ::popen(cmd.c_str(), "w");
+  if (!renderer) {
+    removeTmp();
+    std::fprintf(stderr, "mft-export: cannot start the renderer (%s): %s\n", cmd.c_str(), std::strerror(errno));
+    return kExitBadInput;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  bool write_failed = std::fputs(header.c_str(), renderer) < 0;
+  long frames = 0;
+  double last_t = from;
+  bool interrupted = false;
+  while (!write_failed) {
+    if (services::shutdownRequested()) {
+      interrupted = true;
+      break;
+    }
+    const double t = from + static_cast<double>(frames) * frame_dt;
+    if (t >= to - 1e-9) break;  // frames cover [from, to): the video lasts (to - from) / speed
+    bool any_running = false;
+    for (auto& p : panels) {
+      p->advanceTo(t);
+      any_running = any_running || (p->hasSample() && p->sampleTime() >= t - 1e-9);
+    }
+    // Frames go on while any recording still has data at this time; one that ended shows its last state.
+    if (!any_running) break;
+    std::string line = "{\"type\": \"frame\", \"i\": " + std::to_string(frames) + ", \"panels\": [";
+    for (std::size_t i = 0; i < panels.size(); ++i) line += (i ? ", " : "") + panels[i]->frameJson(t);
+    line += "]}\n";
+    write_failed = std::fputs(line.c_str(), renderer) < 0;
+    last_t = t;
+    ++frames;
+  }
+  const int status = ::pclose(renderer);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const int rc = status == -1 ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  if (interrupted || services::shutdownRequested()) {
+    removeTmp();
+    std::fprintf(stderr, "mft-export: interrupted: no video written\n");
+    return kExitInterrupted;
+  }
+  if (rc != 0) {
+    removeTmp();
+    // The renderer said why on stderr (its messages start with "mft-export:").
+    if (rc != kExitBadInput) std::fprintf(stderr, "mft-export: the renderer failed (exit status %d): no video written\n", rc);
+    return kExitBadInput;
+  }
+  if (frames == 0) {
+    removeTmp();
+    double end = 0.0;
+    for (const auto& p : panels) end = std::max(end, p->hasSample() ? p->sampleTime() : 0.0);
+    cli.fail("--from " + cli.get("from") + " s is not before the end of the recording (" + seconds(end) + ")");
+  }
+  fs::rename(tmp, out);
+  bool corrupt = false;
+  for (const auto& p : panels) {
+    if (p->reader().end() == rawlog::RawlogReader::End::Truncated)
+      std::fprintf(stderr, "mft-export: %s is truncated: drawn up to its last whole record\n", p->path().c_str());
+    if (p->reader().end() == rawlog::RawlogReader::End::Corrupt) {
+      std::fprintf(stderr, "mft-export: %s is %s: drawn up to the damage\n", p->path().c_str(), p->reader().endMessage().c_str());
+      corrupt = true;
+    }
+  }
+  const double video_s = static_cast<double>(frames) / static_cast<double>(fps);
+  const double bytes = static_cast<double>(fs::file_size(out));
+  if (cli.isSet("json")) {
+    std::printf("{\"video\": \"%s\", \"format\": \"%s\", \"frames\": %ld, \"fps\": %ld, \"speed\": %.9g, \"from_s\": %.6f, "
+                "\"last_frame_s\": %.6f, \"video_s\": %.6f, \"panels\": %zu, \"bytes\": %.0f, \"wall_s\": %.3f, "
+                "\"frames_per_s\": %.2f}\n",
+                jsonEscape(out).c_str(), ext.substr(1).c_str(), frames, fps, speed, from, last_t, video_s, panels.size(),
+                bytes, wall, static_cast<double>(frames) / std::max(wall, 1e-9));
+  } else {
+    std::printf("video      %s: %ld frames at %ld fps = %.2f s of video for %.3f-%.3f s of the run (x%g), %zu panel%s, "
+                "%.2f MB, rendered in %.1f s (%.1f frames/s)\n",
+                out.c_str(), frames, fps, video_s, from, last_t + frame_dt, speed, panels.size(), panels.size() > 1 ? "s" : "",
+                bytes / 1e6, wall, static_cast<double>(frames) / std::max(wall, 1e-9));
+  }
+  return corrupt ? kExitCorrupt : 0;
+}
+
+}  // namespace mft::video

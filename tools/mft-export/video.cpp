@@ -195,12 +195,12 @@ class Panel {
           // A push sent on the topic (mft-cmd --push): armed when it arrived (its stamp is the newest
           // simulated time the recorder had seen), applied as the simulator does.
           const auto& d = std::get<msg::Disturbance>(m);
-          if (services::checkDisturbance(d.impulse_Ns(), d.trigger(), d.time_s(), d.leg(), kSimMaxPushNs) !=
+          if (services::checkDisturbance(d.impulse(), d.trigger(), d.time_s(), d.leg(), kSimMaxPushNs) !=
               services::InputVerdict::Ok)
             break;
           const double arrived = static_cast<double>(unix_ns - metadata().time_base_unix_ns) * 1e-9;
-          if (d.trigger() == msg::TRIGGER_AT_TIME) pushes_.push_back({d.impulse_Ns(), -1, std::max(arrived, d.time_s())});
-          else pushes_.push_back({d.impulse_Ns(), d.leg(), arrived});
+          if (d.trigger() == msg::TRIGGER_AT_TIME) pushes_.push_back({d.impulse(), -1, std::max(arrived, d.time_s())});
+          else pushes_.push_back({d.impulse(), d.leg(), arrived});
           break;
         }
         default:

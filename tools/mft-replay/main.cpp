@@ -7,7 +7,9 @@
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
+#include <map>
 #include <memory>
+#include <optional>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -83,56 +85,89 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
   mrpt::obs::CObservation::Ptr obs;
   rawlog::Message m;
   std::int64_t unix_ns = 0;
-  model::RobotStateEstimate state;
-  wbc::WbcReference ref;
-  bool have_state = false, have_ref = false;
+  // mft-wbc answers tick k from RobotState(k) and Reference(k) (lockstep). The recorder stores samples in the
+  // order they reached it, which on a loaded machine is not always the order they were sent (JointCommand(k)
+  // can come before the Reference(k) it answers): inputs and answers are paired by tick, and the controller,
+  // which carries state from tick to tick (the force-rate term, its warm start), runs the ticks in order.
+  struct Tick {
+    std::optional<model::RobotStateEstimate> state;
+    std::optional<wbc::WbcReference> ref;
+    std::optional<msg::JointCommand> command;
+  };
+  std::map<std::uint64_t, Tick> pending;
+  // A tick still incomplete this many ticks behind the newest one never will be (the recorder reorders only
+  // within a few samples).
+  constexpr std::uint64_t kReorderWindow = 256;
   std::uint64_t compared = 0, unmatched = 0, mode_mismatches = 0, differing = 0;
   long long first_diff_tick = -1;
   double max_diff = 0.0, first_diff_value = 0.0;
   long long max_diff_tick = -1;
-  while (reader.next(&obs)) {
-    if (!assembler.add(*obs, &m, &unix_ns)) continue;
-    switch (rawlog::topicOf(m)) {
-      case rawlog::Topic::RobotState:
-        services::fromMsg(std::get<msg::RobotState>(m), &state);
-        have_state = true;
-        break;
-      case rawlog::Topic::Reference:
-        services::fromMsg(std::get<msg::Reference>(m), &ref);
-        have_ref = true;
-        break;
-      case rawlog::Topic::JointCommand: {
-        const auto& rec = std::get<msg::JointCommand>(m);
-        // mft-wbc answers tick k from RobotState(k) and Reference(k) (lockstep).
-        if (!have_state || !have_ref || state.tick != rec.tick() || ref.tick != rec.tick()) {
-          ++unmatched;
-          break;
-        }
-        wbc::WbcDiagnostics diag;
-        const model::ActuatorCommand cmd = controller->update(state, ref, &diag);
-        double d = 0.0;
-        for (int i = 0; i < 4; ++i) d = std::max(d, std::abs(cmd.tau[i] - rec.tau()[static_cast<std::size_t>(i)]));
-        if (!(d == d)) d = std::numeric_limits<double>::infinity();
-        const bool mode_differs = (cmd.mode == model::CommandMode::Damping) != (rec.mode() == msg::COMMAND_MODE_DAMPING);
-        if (mode_differs) ++mode_mismatches;
-        if (d > max_diff) {
-          max_diff = d;
-          max_diff_tick = static_cast<long long>(rec.tick());
-        }
-        if (d > tolerance || mode_differs) {
-          ++differing;
-          if (first_diff_tick < 0) {
-            first_diff_tick = static_cast<long long>(rec.tick());
-            first_diff_value = d;
-          }
-        }
-        ++compared;
+  auto compare = [&](const model::RobotStateEstimate& state, const wbc::WbcReference& ref, const msg::JointCommand& rec) {
+    wbc::WbcDiagnostics diag;
+    const model::ActuatorCommand cmd = controller->update(state, ref, &diag);
+    double d = 0.0;
+    for (int i = 0; i < 4; ++i) d = std::max(d, std::abs(cmd.tau[i] - rec.tau()[static_cast<std::size_t>(i)]));
+    if (!(d == d)) d = std::numeric_limits<double>::infinity();
+    const bool mode_differs = (cmd.mode == model::CommandMode::Damping) != (rec.mode() == msg::COMMAND_MODE_DAMPING);
+    if (mode_differs) ++mode_mismatches;
+    if (d > max_diff) {
+      max_diff = d;
+      max_diff_tick = static_cast<long long>(rec.tick());
+    }
+    if (d > tolerance || mode_differs) {
+      ++differing;
+      if (first_diff_tick < 0) {
+        first_diff_tick = static_cast<long long>(rec.tick());
+        first_diff_value = d;
+      }
+    }
+    ++compared;
+  };
+  // Runs every complete tick at the front; drops a front tick that can no longer complete (`newest` is the
+  // newest tick seen; all: at the end of the file). A dropped tick with a command counts as unmatched.
+  auto drain = [&](std::uint64_t newest, bool all) {
+    while (!pending.empty()) {
+      auto& [tick, t] = *pending.begin();
+      if (t.state && t.ref && t.command) {
+        compare(*t.state, *t.ref, *t.command);
+      } else if (all || newest > tick + kReorderWindow) {
+        if (t.command) ++unmatched;
+      } else {
         break;
       }
-      default:
-        break;
+      pending.erase(pending.begin());
     }
+  };
+  std::uint64_t newest = 0;
+  while (reader.next(&obs)) {
+    if (!assembler.add(*obs, &m, &unix_ns)) continue;
+    std::uint64_t tick = 0;
+    switch (rawlog::topicOf(m)) {
+      case rawlog::Topic::RobotState: {
+        model::RobotStateEstimate state;
+        services::fromMsg(std::get<msg::RobotState>(m), &state);
+        tick = state.tick;
+        pending[tick].state = state;
+        break;
+      }
+      case rawlog::Topic::Reference: {
+        wbc::WbcReference ref;
+        services::fromMsg(std::get<msg::Reference>(m), &ref);
+        tick = ref.tick;
+        pending[tick].ref = ref;
+        break;
+      }
+      case rawlog::Topic::JointCommand:
+        tick = std::get<msg::JointCommand>(m).tick();
+        pending[tick].command = std::get<msg::JointCommand>(m);
+        break;
+      default:
+        continue;
+    }
+    newest = std::max(newest, tick);
+    drain(newest, false);
   }
+  drain(newest, true);
   const bool ok = compared > 0 && differing == 0;
   if (json) {
     std::printf("{\"mode\": \"through-wbc\", \"file\": \"%s\", \"ticks_compared\": %llu, \"unmatched_commands\": %llu, "

@@ -6,22 +6,19 @@ planner's reason. One realtime stack on DDS domain 226, started through the supe
 pid) even when a test fails. Needs MFT_BIN_DIR (set by CTest)."""
 import json
 import math
-import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import time
 import unittest
 from pathlib import Path
 
 import yaml
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.testing import BIN, CONFIG, StackRunner  # noqa: E402
+
 DOMAIN = 226
-ROBOT = yaml.safe_load((REPO / "config" / "robot.yaml").read_text())
+ROBOT = yaml.safe_load((CONFIG / "robot.yaml").read_text())
 PEAK_TORQUE = ROBOT["actuator"]["gear_ratio"] * ROBOT["actuator"]["motor_peak_torque_Nm"]
 SCENARIO_HEIGHT = 0.42  # step-in-place.yaml
 NEW_HEIGHT = 0.40
@@ -42,19 +39,16 @@ class CycloneOnTheStack(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.tmp = Path(tempfile.mkdtemp(prefix="mft-interop-test-"))
-        cls.env = dict(os.environ, MFT_RUNS_DIR=str(cls.tmp / "runs"))
-        cls.run_dir = cls.tmp / "run"
-        p = subprocess.run([sys.executable, str(SUPERVISOR), "up", str(REPO / "config" / "scenarios" / "step-in-place.yaml"),
-                            "--domain", str(DOMAIN), "--mode", "realtime", "--run-dir", str(cls.run_dir), "--bin-dir",
-                            str(BIN)], env=cls.env, capture_output=True, text=True, timeout=180)
-        cls.up_error = None if p.returncode == 0 else f"supervisor up failed ({p.returncode}): {p.stderr[-2000:]}"
+        cls.stacks = StackRunner(prefix="mft-interop-test-")
+        try:
+            cls.status = cls.stacks.up("step-in-place.yaml", DOMAIN, "--mode", "realtime")
+            cls.up_error = None
+        except AssertionError as e:
+            cls.up_error = str(e)
 
     @classmethod
     def tearDownClass(cls):
-        subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN)], env=cls.env,
-                       capture_output=True, timeout=60)
-        shutil.rmtree(cls.tmp, ignore_errors=True)
+        cls.stacks.close()
 
     def setUp(self):
         if self.up_error:
@@ -111,12 +105,9 @@ class CycloneOnTheStack(unittest.TestCase):
         self.assertIn("0.9", r["reason"])
 
     def test_4_the_planner_counted_both_commands(self):
-        code = subprocess.run([sys.executable, str(SUPERVISOR), "down", "--domain", str(DOMAIN)], env=self.env,
-                              capture_output=True, text=True, timeout=60).returncode
-        self.assertEqual(code, 0)
-        ops = json.loads((self.run_dir / "mft-planner.summary.json").read_text())["operator_commands"]
+        planner = self.stacks.down(DOMAIN, self.status, names=("mft-planner",))["mft-planner"]
+        ops = planner["operator_commands"]
         self.assertEqual((ops["received"], ops["applied"], ops["rejected"]), (2, 1, 1), ops)
-
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)

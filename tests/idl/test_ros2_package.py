@@ -5,11 +5,14 @@ mft), the same fields in the same order with the matching ROS 2 types and array 
 in the message that uses it, ROS 2's naming rules, and a package.xml / CMakeLists.txt that list it all. Parses
 both sides itself; needs no ROS 2 installation."""
 import re
+import sys
 import unittest
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parent.parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.paths import REPO  # noqa: E402
+
 IDL = REPO / "idl" / "mft_msgs.idl"
 PKG = REPO / "ros2" / "mft"
 # IDL type -> ROS 2 .msg type (the wire layout is the same: char and octet are one byte each)

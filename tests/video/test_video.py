@@ -21,9 +21,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-REPO = Path(__file__).resolve().parent.parent.parent
-SUPERVISOR = REPO / "services" / "mft-supervisor"
-BIN = Path(os.environ.get("MFT_BIN_DIR", REPO / "build" / "release" / "bin"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack.paths import DEFAULT_BIN as BIN, REPO, SUPERVISOR  # noqa: E402
 EXPORT = BIN / "mft-export"
 DOMAIN = 6 + os.getpid() % 4  # a block no other test uses (rawlog 10-89, experiments 90-99, stacks 100+)
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 #include <ctime>
 #include <sstream>
 
@@ -557,6 +558,58 @@ TEST(RawlogBadInput, ExportAndReplayRefuseAHugeDeclaredObjectInWellUnderASecond)
   EXPECT_EQ(r.code, 4) << r.err;  // corrupt: exported up to the damage
   EXPECT_NE(r.err.find("AIN_8bits"), std::string::npos) << r.err;
   EXPECT_LT(r.seconds, 2.0);
+}
+
+// The recorder stores samples in arrival order; on a loaded machine a JointCommand(k) can arrive before the
+// Reference(k) it answers. `mft-replay --through-wbc` pairs them by tick: every command is compared (random
+// contents, so the torques themselves differ: the tolerance is set out of the way), none is "unmatched".
+TEST(RawlogReplay, ThroughWbcPairsInputsAndCommandsByTickWhateverTheRecordedOrder) {
+  TempDir dir;
+  RecorderOptions opt;
+  opt.output = dir.file("reordered.rawlog");
+  opt.metadata = testMetadata();
+  for (const char* name : {"robot.yaml", "wbc.yaml", "mft_space.yaml"}) {
+    std::ifstream in(std::string(MFT_CONFIG_DIR) + "/" + name);
+    std::stringstream text;
+    text << in.rdbuf();
+    opt.metadata.config[name] = text.str();
+  }
+  // No reordering window: a sample is written as soon as the writer sees it (what a sample held past the
+  // recorder's wall-clock hold on a loaded machine gets).
+  opt.reorder_window_ns = 0;
+  constexpr std::uint64_t kTicks = 40;
+  const auto command = static_cast<std::size_t>(Topic::JointCommand);
+  std::mt19937_64 g(11);
+  {
+    Recorder rec(opt);
+    rec.start();
+    for (std::uint64_t k = 0; k < kTicks; ++k) {
+      auto m = tickMessages(k, g);  // GroundTruth, SensorData, RobotState, Reference, JointCommand, diagnostics
+      if (k % 2 == 0) {
+        for (const auto& x : m) rec.push(x);
+        continue;
+      }
+      // The command is written before its reference arrives.
+      for (std::size_t i : {0, 1, 2, 4, 5}) rec.push(m[i]);
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (rec.stats().topics[command].written < k + 1 && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ASSERT_EQ(rec.stats().topics[command].written, k + 1) << "the recorder did not write JointCommand " << k;
+      rec.push(m[3]);
+    }
+    rec.stop();
+  }
+  const std::string cmd = std::string(MFT_BIN_DIR) + "/mft-replay " + opt.output +
+                          " --through-wbc --tolerance 1e9 --json > " + dir.file("replay.json") + " 2> " +
+                          dir.file("replay.err");
+  const int status = std::system(cmd.c_str());
+  std::stringstream out, err;
+  out << std::ifstream(dir.file("replay.json")).rdbuf();
+  err << std::ifstream(dir.file("replay.err")).rdbuf();
+  const std::string json = out.str();
+  ASSERT_TRUE(WIFEXITED(status)) << err.str();
+  EXPECT_NE(json.find("\"ticks_compared\": " + std::to_string(kTicks) + ","), std::string::npos) << json << err.str();
+  EXPECT_NE(json.find("\"unmatched_commands\": 0,"), std::string::npos) << json << err.str();
 }
 
 // Item 12: what a file is when it is not a rawlog, instead of "empty file".

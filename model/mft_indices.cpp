@@ -31,4 +31,12 @@ FiveBarStatus transmissionIndicesAt(const FiveBarGeometry& g, double q_rear, dou
   return s;
 }
 
+double legTransmissionIndex(const VectorQ& q, int leg) {
+  const double knee_r = q[kneeRearIndex(leg)];
+  const double knee_f = q[kneeForeIndex(leg)];
+  const double shank_r = q[hipRearIndex(leg)] + knee_r;
+  const double shank_f = q[hipForeIndex(leg)] + knee_f;
+  return std::min({std::abs(std::sin(knee_r)), std::abs(std::sin(knee_f)), std::abs(std::sin(shank_f - shank_r))});
+}
+
 }  // namespace mft::model

@@ -2,6 +2,7 @@
 // Local transmission index (LTI) of one planar five-bar leg: paper eq. 3-4, closed forms of docs/five-bar-theory.md#transmission-indices-lti.
 // ITI of chain i = |sin(knee_i)| = |e_i x u_i|, OTI = |u_r x u_f| (both chains), LTI = min of all three.
 // Every value is finite and lies in [0, 1]; a singular configuration gives 0, never NaN.
+#include "model/coordinates.hpp"
 #include "model/five_bar.hpp"
 
 namespace mft::model {
@@ -21,5 +22,10 @@ TransmissionIndices transmissionIndices(const FiveBarPose& pose);
 // output singularity, all indices 0 except the ITIs that the geometry still defines. Unreachable gives zeros
 // and returns the status so the caller can tell the two apart.
 FiveBarStatus transmissionIndicesAt(const FiveBarGeometry& g, double q_rear, double q_fore, TransmissionIndices* out);
+
+// LTI of leg `leg` (0 right, 1 left) straight from the generalized coordinates, as the WBC's diagnostics and the
+// simulator's fall check use it: min(|sin knee_rear|, |sin knee_fore|, |sin(shank_fore - shank_rear)|), shank =
+// hip + knee (absolute); the same indices as transmissionIndices() of the solved pose.
+double legTransmissionIndex(const VectorQ& q, int leg);
 
 }  // namespace mft::model

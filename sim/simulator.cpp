@@ -12,7 +12,7 @@
 #include <stdexcept>
 
 #include "model/five_bar.hpp"
-#include "sim/leg_indices.hpp"
+#include "model/mft_indices.hpp"
 #include "sim/ode_robot.hpp"
 #include "sim/ode_terrain.hpp"
 #include "sim/sea_actuator.hpp"
@@ -400,7 +400,7 @@ void Simulator::refreshOutputs(const Vector2d& imu_vel_before) {
   for (int leg = 0; leg < kNumLegs; ++leg) {
     const auto l = static_cast<std::size_t>(leg);
     truth_.contact_force.segment<2>(2 * leg) = m.force_sum[l] * inv_n;  // mean over the control period
-    truth_.lti[l] = legTransmissionIndex(truth_.q, leg);
+    truth_.lti[l] = model::legTransmissionIndex(truth_.q, leg);
   }
   model::SensorReadings& s = sensors_;
   s.tick = tick_;

@@ -51,8 +51,8 @@ Task footTask(const char* name, int leg) {
     const int r = 2 * leg;
     t->A = c.model->Jc.middleRows<2>(r);
     for (int i = 0; i < 2; ++i) {
-      const double xdd_des = c.ref->foot_acc[r + i] + g.kp[i] * (c.ref->foot_pos[r + i] - c.model->foot_pos[r + i]) +
-                             g.kd[i] * (c.ref->foot_vel[r + i] - c.model->foot_vel[r + i]);
+      const Setpoint1 ref{c.ref->foot_pos[r + i], c.ref->foot_vel[r + i], c.ref->foot_acc[r + i]};
+      const double xdd_des = pdAcceleration(ref, c.model->foot_pos[r + i], c.model->foot_vel[r + i], {g.kp[i], g.kd[i]});
       t->b(i) = xdd_des - c.model->Jc_dot_qd[r + i];
     }
   });
@@ -168,7 +168,7 @@ Formulation buildFormulation(const WbcParams& params) {
       model::VectorA qa_pred;
       for (int i = 0; i < kNa; ++i) {
         const int j = model::kActuatedIndex[i];
-        qa_pred[i] = c.state->q[j] + c.state->qd[j] * p.dt;
+        qa_pred[i] = predictedCoordinate(c.state->q[j], c.state->qd[j], 0.0, p.dt);
         k->A.col(j) = 0.5 * p.dt * p.dt * p.mft.A.col(i);
       }
       k->A.block<kNeps, kNeps>(0, kNqdd + kNfc) = -Eigen::Matrix<double, kNeps, kNeps>::Identity();
@@ -186,7 +186,7 @@ Formulation buildFormulation(const WbcParams& params) {
       const double reach = s * p.qdd_joint_max;
       for (int i = 0; i < kNa; ++i) {
         const int j = model::kPassiveIndex[i];
-        const double nominal = c.state->q[j] + c.state->qd[j] * p.dt;
+        const double nominal = predictedCoordinate(c.state->q[j], c.state->qd[j], 0.0, p.dt);
         k->A(i, j) = s;
         k->lower(i) = std::min(p.passive_lo[i] - nominal, reach);
         k->upper(i) = std::max(p.passive_hi[i] - nominal, -reach);

@@ -6,7 +6,7 @@
 #include <optional>
 #include <stdexcept>
 
-#include "wbc/leg_indices.hpp"
+#include "model/mft_indices.hpp"
 #include "wbc/wbc_assembly.hpp"
 
 namespace mft::wbc {
@@ -96,7 +96,7 @@ void WholeBodyController::fillStateDiagnostics(const model::RobotStateEstimate& 
   diag->num_tasks = static_cast<int>(formulation_.tasks.size());
   if (!state.q.allFinite()) return;
   for (int leg = 0; leg < model::kNumLegs; ++leg) {
-    diag->lti[leg] = legLti(state.q, leg);
+    diag->lti[leg] = model::legTransmissionIndex(state.q, leg);
     // RACI depends on the hip angles only (docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia); +inf at a singularity, NaN if unreachable.
     model::FiveBarPose pose;
     if (model::fiveBarForward(leg_geometry_, state.q[model::hipRearIndex(leg)], state.q[model::hipForeIndex(leg)],
@@ -196,7 +196,7 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
       model::VectorA q_pred;
       for (int i = 0; i < model::kNa; ++i) {
         const int j = model::kActuatedIndex[i];
-        q_pred[i] = state.q[j] + state.qd[j] * params_.dt + 0.5 * qdd[j] * params_.dt * params_.dt;
+        q_pred[i] = predictedCoordinate(state.q[j], state.qd[j], qdd[j], params_.dt);
       }
       diag->mft_violation_predicted = polytopeViolation(q_pred);
     }

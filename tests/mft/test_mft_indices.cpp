@@ -141,3 +141,25 @@ TEST(MftIndices, EveryIndexIsFiniteAndInRangeOverTheWholeBox) {
     }
   }
 }
+
+// The LTI the WBC's diagnostics and the simulator's fall check take from the generalized coordinates equals the
+// LTI of the solved five-bar pose (the closed forms above), for both legs.
+TEST(MftIndices, LegIndexFromGeneralizedCoordinatesMatchesTheSolvedPose) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> q(-1.9, 1.9);
+  const FiveBarGeometry g = kGeometries[0];
+  int checked = 0;
+  while (checked < 400) {
+    FiveBarPose p;
+    if (fiveBarForward(g, q(rng), q(rng), &p) != FiveBarStatus::Ok) continue;
+    for (int leg = 0; leg < 2; ++leg) {
+      VectorQ gq = VectorQ::Zero();
+      gq[hipRearIndex(leg)] = p.q_rear;
+      gq[kneeRearIndex(leg)] = p.knee_rear;
+      gq[hipForeIndex(leg)] = p.q_fore;
+      gq[kneeForeIndex(leg)] = p.knee_fore;
+      EXPECT_NEAR(legTransmissionIndex(gq, leg), transmissionIndices(p).lti(), 1e-12);
+    }
+    ++checked;
+  }
+}

@@ -2,7 +2,7 @@
 // polytope, none does not; sa keeps the predicted passive knees inside the bounds of eq. 14.
 #include <gtest/gtest.h>
 
-#include "wbc/leg_indices.hpp"
+#include "model/mft_indices.hpp"
 #include "wbc/whole_body_controller.hpp"
 #include "wbc_test_support.hpp"
 
@@ -179,8 +179,8 @@ TEST(WbcVariants, LtiOfTheNominalStanceMatchesTheTheory) {
   s.right_foot = {0.0, -0.40};
   s.left_foot = {0.0, -0.44};
   const model::RobotStateEstimate st = makeState(s);
-  EXPECT_NEAR(legLti(st.q, 0), 0.875, 2e-3);
-  EXPECT_NEAR(legLti(st.q, 1), 0.683, 2e-3);
+  EXPECT_NEAR(model::legTransmissionIndex(st.q, 0), 0.875, 2e-3);
+  EXPECT_NEAR(model::legTransmissionIndex(st.q, 1), 0.683, 2e-3);
 }
 
 }  // namespace

@@ -107,9 +107,16 @@ def cmd_run(args):
         stack = Stack(args, scenario)
         stack.stop_flag = stop
     wall = time.monotonic() - t0
+    stop_failures = []
     for name, svc in stack.services.items():
         if svc.proc is not None and svc.proc.returncode not in (0, None, -signal.SIGTERM) and name not in stack.failed:
             stack.failed.append(name)
+            killed = any(e["service"] == name and e["event"] == "killed after grace period" for e in stack.events)
+            stop_failures.append(f"{name} exited with status {svc.proc.returncode}"
+                                 + (f" (killed: it had not stopped {STOP_GRACE_S:.0f} s after SIGTERM)" if killed else "")
+                                 + f"; see {svc.log_path}")
+    if stop_failures and error is None:  # a service that failed only at the stop says how, not just its name
+        error = "; ".join(stop_failures)
     summary = build_summary(stack, wall, error)
     summary["failed"] = stack.failed
     summary["ok"] = error is None and not stack.failed

@@ -64,7 +64,7 @@ def on_term(*_):
     stop = True
 
 
-signal.signal(signal.SIGTERM, on_term)
+signal.signal(signal.SIGTERM, signal.SIG_IGN if "ignore_term" in behaviour else on_term)  # a service hung at stop
 signal.signal(signal.SIGINT, on_term)
 if "fail_start" in behaviour:  # exits before it is ready, with this message
     print(f"{name}: {behaviour['fail_start']}", flush=True)

@@ -41,6 +41,13 @@ struct MftFitSummary {
   int reachable_cells = 0;
 };
 
+// Paper (10): the largest row of A q_a - b, q_a = [q4, q6, q8, q10]; <= 0 inside the preferable polytope.
+template <int Rows>
+double polytopeViolation(const Eigen::Matrix<double, Rows, kNa>& A, const Eigen::Matrix<double, Rows, 1>& b,
+                         const VectorA& q_a) {
+  return (A * q_a - b).maxCoeff();
+}
+
 struct MftPolytope {
   Eigen::Matrix<double, kMftRows, kNa> A = Eigen::Matrix<double, kMftRows, kNa>::Zero();
   Eigen::Matrix<double, kMftRows, 1> b = Eigen::Matrix<double, kMftRows, 1>::Zero();
@@ -52,7 +59,7 @@ struct MftPolytope {
   std::string source_file;
 
   // q_a = [q4, q6, q8, q10].
-  bool contains(const VectorA& q_a, double tol = 0.0) const { return ((A * q_a - b).array() <= tol).all(); }
+  bool contains(const VectorA& q_a, double tol = 0.0) const { return polytopeViolation(A, b, q_a) <= tol; }
 };
 
 // blkdiag(A_leg, A_leg) and [b_leg; b_leg]; needs a hexagon.

@@ -368,21 +368,42 @@ void closureProjection(const ModelData& data, ClosureProjection* out) {
   out->N_h = MatrixQ::Identity() - Minv_JhT * out->Lambda_h * data.Jh;
 }
 
+bool actuatedTorqueMap(const ModelData& data, const ClosureProjection& proj, ActuatedTorqueMap* out) {
+  Eigen::Matrix<double, kNa, kNq> SaNhT;    // S_a N_h' (rows of N_h' are columns of N_h)
+  Eigen::Matrix<double, kNa, kNq> SaM;      // S_a M
+  Eigen::Matrix<double, kNa, kNh> SaJhT;    // S_a J_h'
+  Eigen::Matrix<double, kNa, kNa> SaNhTSaT;  // S_a N_h' S_a'
+  for (int i = 0; i < kNa; ++i) {
+    const int j = kActuatedIndex[i];
+    SaNhT.row(i) = proj.N_h.col(j).transpose();
+    SaM.row(i) = data.M.row(j);
+    SaJhT.row(i) = data.Jh.col(j).transpose();
+  }
+  for (int k = 0; k < kNa; ++k) SaNhTSaT.col(k) = SaNhT.col(kActuatedIndex[k]);
+  // 4x4 with a closed-form inverse in Eigen: no pivoting search, no allocation.
+  const Eigen::Matrix<double, kNa, kNa> K = SaNhTSaT.inverse();
+  out->tau_qdd.noalias() = K * SaM;
+  const Eigen::Matrix<double, kNa, kNc> SaNhTJcT = SaNhT * data.Jc.transpose();
+  out->tau_fc.noalias() = -K * SaNhTJcT;
+  const VectorH lambda_jdqd = proj.Lambda_h * data.Jh_dot_qd;
+  const VectorA inner = SaNhT * data.h + SaJhT * lambda_jdqd;
+  out->tau_0.noalias() = K * inner;
+  return out->tau_qdd.allFinite() && out->tau_fc.allFinite() && out->tau_0.allFinite();
+}
+
+VectorA actuatedTorque(const ActuatedTorqueMap& map, const VectorQ& qdd, const VectorC& f_c) {
+  VectorA tau = map.tau_0;
+  tau.noalias() += map.tau_qdd * qdd;
+  tau.noalias() += map.tau_fc * f_c;
+  return tau;
+}
+
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c) {
   (void)qd;  // the velocity enters only through data.Jh_dot_qd (and data.h), computed by updateModel at it
-  const MatrixQ NhT = proj.N_h.transpose();
-  const VectorQ generalized = data.M * qdd + NhT * data.h +
-                              data.Jh.transpose() * (proj.Lambda_h * data.Jh_dot_qd) -
-                              NhT * (data.Jc.transpose() * f_c);
-  // S_a (.) S_a' picks the actuated rows and columns.
-  Eigen::Matrix<double, kNa, kNa> projected_selection;
-  VectorA selected;
-  for (int r = 0; r < kNa; ++r) {
-    selected(r) = generalized(kActuatedIndex[r]);
-    for (int c = 0; c < kNa; ++c) projected_selection(r, c) = NhT(kActuatedIndex[r], kActuatedIndex[c]);
-  }
-  return projected_selection.partialPivLu().solve(selected);
+  ActuatedTorqueMap map;
+  actuatedTorqueMap(data, proj, &map);  // a non-finite map gives a non-finite torque, which callers check
+  return actuatedTorque(map, qdd, f_c);
 }
 
 VectorQ closedLoopConfiguration(const RobotDescription& d, const Eigen::Vector3d& base_pose,

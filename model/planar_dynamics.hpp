@@ -109,8 +109,24 @@ struct ClosureProjection {
 };
 void closureProjection(const ModelData& data, ClosureProjection* out);
 
-// Paper eq. 7: actuated torques realising qdd with contact forces f_c. The velocity terms come from data
-// (h and Jh_dot_qd of the last updateModel call), so qd must be the velocity data was updated with.
+// Paper eq. 7 as an affine map of the QP's unknowns (qdd, f_c): the one place the actuated torque is computed.
+// The WBC bounds tau with these matrices and decodes its command from them, so the torque the QP limits and
+// the torque the robot receives are the same numbers.
+//   tau_a = tau_qdd qdd + tau_fc f_c + tau_0,  K = (S_a N_h' S_a')^-1,
+//   tau_qdd = K S_a M,  tau_fc = -K S_a N_h' J_c',  tau_0 = K S_a (N_h' h + J_h' Lambda_h Jdot_h qd).
+struct ActuatedTorqueMap {
+  Eigen::Matrix<double, kNa, kNq> tau_qdd;
+  Eigen::Matrix<double, kNa, kNc> tau_fc;
+  VectorA tau_0;
+};
+// Needs data from updateModel and proj from closureProjection at the same state. Allocation-free. Returns false
+// if the result is not finite (S_a N_h' S_a' singular, e.g. at a leg singularity).
+bool actuatedTorqueMap(const ModelData& data, const ClosureProjection& proj, ActuatedTorqueMap* out);
+// The map evaluated at (qdd, f_c).
+VectorA actuatedTorque(const ActuatedTorqueMap& map, const VectorQ& qdd, const VectorC& f_c);
+
+// Paper eq. 7 in one call: actuatedTorqueMap, then actuatedTorque. The velocity terms come from data (h and
+// Jh_dot_qd of the last updateModel call), so qd must be the velocity data was updated with.
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c);
 

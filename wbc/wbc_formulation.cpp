@@ -156,10 +156,10 @@ Formulation buildFormulation(const WbcParams& params) {
   });
   // 16c: tau_min <= tau_a(qdd, f_c) <= tau_max through the affine map of eq. 7.
   f.constraints.emplace_back("in_torque", Type::Inequality, kNa, [](const TickContext& c, Constraint* k) {
-    k->A.block<kNa, kNqdd>(0, 0) = c.dyn->tau_qdd;
-    k->A.block<kNa, kNfc>(0, kNqdd) = c.dyn->tau_fc;
-    k->lower = -c.params->tau_max - c.dyn->tau_0;
-    k->upper = c.params->tau_max - c.dyn->tau_0;
+    k->A.block<kNa, kNqdd>(0, 0) = c.dyn->torque.tau_qdd;
+    k->A.block<kNa, kNfc>(0, kNqdd) = c.dyn->torque.tau_fc;
+    k->lower = -c.params->tau_max - c.dyn->torque.tau_0;
+    k->upper = c.params->tau_max - c.dyn->torque.tau_0;
   });
   // 16e with eq. 10-11 (J = S_a, Jdot qd = 0): C qdd - eps <= d, C = dt^2/2 A S_a, d = b - A (q_a + qd_a dt).
   if (params.variant == WbcVariant::Mft) {

@@ -85,7 +85,7 @@ void WholeBodyController::resetSafety() {
 
 double WholeBodyController::polytopeViolation(const model::VectorA& q_a) const {
   if (!has_polytope_) return std::numeric_limits<double>::quiet_NaN();
-  return (params_.mft.A * q_a - params_.mft.b).maxCoeff();
+  return model::polytopeViolation(params_.mft.A, params_.mft.b, q_a);
 }
 
 void WholeBodyController::fillStateDiagnostics(const model::RobotStateEstimate& state, const WbcReference& ref,
@@ -201,8 +201,9 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
       diag->mft_violation_predicted = polytopeViolation(q_pred);
     }
 
-    // Eq. 7, then the actuator limits (the QP keeps tau inside them up to its tolerance).
-    model::VectorA tau = model::inverseDynamicsActuated(data_, proj_, qdd, state.qd, f_c);
+    // Eq. 7 decoded from the same matrices the QP's torque rows used, then the actuator limits (the QP keeps
+    // tau inside them up to its tolerance).
+    model::VectorA tau = model::actuatedTorque(dyn_.torque, qdd, f_c);
     if (!tau.allFinite()) return finish(fail(SafetyEvent::NonFiniteOutput, state, diag));
     for (int i = 0; i < model::kNa; ++i) {
       const double lim = params_.tau_max[i];

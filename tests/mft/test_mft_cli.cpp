@@ -2,6 +2,7 @@
 // crash; `index --json` answers for one configuration.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -14,8 +15,9 @@ struct CliRun {
   std::string out, err;
 };
 CliRun run(const std::string& args) {
-  const std::string dir = ::testing::TempDir();
-  const std::string out = dir + "/mft_cli_out.txt", err = dir + "/mft_cli_err.txt";
+  // Per-process names: CTest may run these tests in parallel (ctest -j).
+  const std::string dir = ::testing::TempDir() + "/mft_cli_" + std::to_string(getpid());
+  const std::string out = dir + "_out.txt", err = dir + "_err.txt";
   const std::string cmd = std::string(MFT_BIN_DIR) + "/mft-space " + args + " > " + out + " 2> " + err;
   const int status = std::system(cmd.c_str());
   CliRun r;
@@ -57,7 +59,7 @@ TEST(MftSpaceCli, BadArgumentsExitWithCode2) {
 
 TEST(MftSpaceCli, BadConfigExitsWithCode2) {
   expectUsage("index --rear 0.1 --fore 0.5 --robot /nonexistent/robot.yaml", "cannot open the file");
-  const std::string bad = ::testing::TempDir() + "/mft_bad_space.yaml";
+  const std::string bad = ::testing::TempDir() + "/mft_bad_space_" + std::to_string(getpid()) + ".yaml";
   std::ofstream(bad) << "schema_version: 1\nrobot: {name: x}\n";
   expectUsage("stance --polytope " + bad, "bad configuration");
   std::ofstream(bad) << "not: [valid";

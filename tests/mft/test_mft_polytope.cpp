@@ -3,7 +3,9 @@
 // round-trips.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -67,7 +69,7 @@ TEST(MftPolytope, CommittedFileMatchesTheRobotDescription) {
 TEST(MftPolytope, CommittedFileIsReproducedByARefit) {
   const RobotDescription robot = loadRobotDescription(robotPath());
   const MftPolytope p = loadMftPolytope(polytopePath(), robot);
-  const std::string out = ::testing::TempDir() + "/mft_space_refit.yaml";
+  const std::string out = ::testing::TempDir() + "/mft_space_refit_" + std::to_string(getpid()) + ".yaml";
   const auto& c = p.criteria;
   std::string cmd = std::string(MFT_BIN_DIR) + "/mft-space fit --quiet --robot " + robotPath() + " --output " + out +
                     " --joint-step " + fmt(p.fit.joint_step_rad) + " --cart-step " + fmt(p.fit.cartesian_step_m) +
@@ -136,4 +138,26 @@ TEST(MftPolytope, AugmentedRowsThatDisagreeWithTheLegPolygonAreRefused) {
   text.insert(pos + 7, "0.5 + ");
   text = std::regex_replace(text, std::regex("\\[0\\.5 \\+ ([-0-9.e]+)"), "[9.99");
   EXPECT_THROW(parseMftPolytope(text, "x.yaml", robot), ConfigError);
+}
+
+TEST(MftPolytope, ViolationIsTheLargestRowOfAqMinusB) {
+  // Independent of the Eigen expression: each row written out as a dot product.
+  const RobotDescription robot = loadRobotDescription(robotPath());
+  const MftPolytope p = loadMftPolytope(polytopePath(), robot);
+  std::srand(7);
+  int inside = 0;
+  for (int k = 0; k < 200; ++k) {
+    const VectorA q = VectorA(-0.6435, 0.6435, -0.6435, 0.6435) + 0.6 * VectorA::Random();
+    double worst = -1e300;
+    for (int r = 0; r < kMftRows; ++r) {
+      double row = -p.b[r];
+      for (int c = 0; c < kNa; ++c) row += p.A(r, c) * q[c];
+      worst = std::max(worst, row);
+    }
+    EXPECT_NEAR(polytopeViolation(p.A, p.b, q), worst, 1e-12);
+    EXPECT_EQ(p.contains(q), worst <= 0.0);
+    inside += worst <= 0.0;
+  }
+  EXPECT_GT(inside, 10);   // the sample straddles the boundary: both answers occur
+  EXPECT_LT(inside, 190);
 }

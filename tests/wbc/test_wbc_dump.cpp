@@ -1,4 +1,5 @@
 // The QP of a tick dumped in the shared WBCQP v1 format reads back identically and solves to the same x.
+#include <unistd.h>
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -21,7 +22,7 @@ TEST(WbcQpDump, RoundTripThroughTheSharedFormat) {
   WbcDiagnostics diag;
   wbc.update(st, test::holdReference(st, true, true), &diag);
   ASSERT_EQ(diag.status, qp::QpStatus::Optimal);
-  const std::string path = ::testing::TempDir() + "/wbc_01234.txt";
+  const std::string path = ::testing::TempDir() + "/wbc_01234_" + std::to_string(getpid()) + ".txt";
   wbc.writeLastQp(path);
 
   const qp::QpInstance inst = qp::readQpInstance(path);

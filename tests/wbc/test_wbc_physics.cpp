@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include "wbc/whole_body_controller.hpp"
 #include "wbc_test_support.hpp"
@@ -124,9 +125,22 @@ TEST(WbcDynamicsTerms, AffineTorqueMapEqualsInverseDynamics) {
   for (int k = 0; k < 5; ++k) {
     const model::VectorQ qdd = model::VectorQ::Random() * 5.0;
     const model::VectorC fc = model::VectorC::Random() * 100.0;
-    const model::VectorA a = t.tau_qdd * qdd + t.tau_fc * fc + t.tau_0;
-    const model::VectorA b = model::inverseDynamicsActuated(d, p, qdd, st.qd, fc);
+    const model::VectorA a = model::actuatedTorque(t.torque, qdd, fc);
+    // Independent of the map's factorisation: eq. 7 as generalized forces projected by N_h', the actuated rows
+    // and columns picked, and the 4x4 system solved by pivoted LU.
+    const model::MatrixQ NhT = p.N_h.transpose();
+    const model::VectorQ generalized = d.M * qdd + NhT * d.h + d.Jh.transpose() * (p.Lambda_h * d.Jh_dot_qd) -
+                                       NhT * (d.Jc.transpose() * fc);
+    Eigen::Matrix<double, model::kNa, model::kNa> selection;
+    model::VectorA selected;
+    for (int r = 0; r < model::kNa; ++r) {
+      selected(r) = generalized(model::kActuatedIndex[r]);
+      for (int c = 0; c < model::kNa; ++c) selection(r, c) = NhT(model::kActuatedIndex[r], model::kActuatedIndex[c]);
+    }
+    const model::VectorA b = selection.partialPivLu().solve(selected);
     EXPECT_LT((a - b).cwiseAbs().maxCoeff(), 1e-9 * (1.0 + b.cwiseAbs().maxCoeff()));
+    // The one-call form is the same map evaluated.
+    EXPECT_EQ(model::inverseDynamicsActuated(d, p, qdd, st.qd, fc), a);
   }
   // At a closed loop S_f N_h' = S_f (J_h has no base columns), so 16a is the plain floating-base row of eq. 1.
   EXPECT_LT((t.base_NhT - Eigen::Matrix<double, 3, model::kNq>::Identity()).cwiseAbs().maxCoeff(), 1e-9);

@@ -222,7 +222,7 @@ int exportMain(int argc, char** argv) {
   if (reader->end() == rawlog::RawlogReader::End::Truncated)
     std::fprintf(stderr, "mft-export: the file is truncated: read up to its last whole record\n");
   if (cli.isSet("plot") && reader->end() != rawlog::RawlogReader::End::Corrupt) {
-    const std::string cmd = "/usr/bin/python3 '" + std::string(MFT_PLOT_SCRIPT) + "' '" + csv_dir + "' '" +
+    const std::string cmd = "/usr/bin/python3 '" + config::dataFileFor("scripts/mft-plot.py", MFT_PLOT_SCRIPT) + "' '" + csv_dir + "' '" +
                             cli.get("plot") + "'" + (json ? " >&2" : "");
     const int rc = std::system(cmd.c_str());
     if (rc != 0) {

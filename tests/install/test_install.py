@@ -190,6 +190,41 @@ class InstalledPrefix(unittest.TestCase):
         logs = " ".join(f.read_text(errors="replace") for f in (self.tmp / "run").glob("*.log"))
         self.assertNotIn(str(Path(ARGS.source_dir).resolve()) + "/config", logs)
 
+    def test_6_every_header_and_target(self):
+        """One program including every installed header, linking all seven targets; the simulator (libode through
+        the package file's pkg-config) steps ten control ticks."""
+        src, build = self.tmp / "all-src", self.tmp / "all-build"
+        src.mkdir()
+        include = self.prefix / "include" / "mft"
+        headers = sorted(str(h.relative_to(include)) for h in include.rglob("*.hpp"))
+        self.assertGreater(len(headers), 40)
+        components = ["config", "model", "qp", "wbc", "planner", "estimator", "sim"]
+        (src / "CMakeLists.txt").write_text(
+            "cmake_minimum_required(VERSION 3.22)\nproject(all_headers LANGUAGES CXX)\n"
+            f"find_package(mft_wbc REQUIRED COMPONENTS {' '.join(components)})\n"
+            "add_executable(all_headers main.cpp)\n"
+            f"target_link_libraries(all_headers PRIVATE {' '.join('mft::' + c for c in components)})\n")
+        (src / "main.cpp").write_text("".join(f'#include "{h}"\n' for h in headers) + """
+#include <cstdio>
+int main(int argc, char** argv) {
+  if (argc < 2) return 2;
+  const std::string dir = argv[1];
+  const auto robot = mft::model::loadRobotDescription(dir + "/robot.yaml");
+  mft::sim::Simulator sim(robot, mft::sim::loadSimOptions(dir + "/sim.yaml"), mft::sim::Terrain::flat());
+  for (int i = 0; i < 10; ++i) sim.step();
+  std::printf("%llu\\n", static_cast<unsigned long long>(sim.stats().control_steps));
+  return 0;
+}
+""")
+        r = run([ARGS.cmake, "-S", src, "-B", build, "-G", ARGS.generator, "-DCMAKE_BUILD_TYPE=Release",
+                 f"-DCMAKE_PREFIX_PATH={self.prefix}", "-DCMAKE_FIND_PACKAGE_NO_PACKAGE_REGISTRY=ON"], env=self.env)
+        self.assertEqual(r.returncode, 0, f"configure:\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}")
+        r = run([ARGS.cmake, "--build", build], env=self.env)
+        self.assertEqual(r.returncode, 0, f"build:\n{r.stdout[-3000:]}\n{r.stderr[-3000:]}")
+        r = run([build / "all_headers", self.share / "config"], env=self.env)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(r.stdout.strip(), "10")
+
     def test_5_debian_package(self):
         out = self.tmp / "deb"
         r = run([ARGS.cpack, "--config", Path(ARGS.build_dir) / "CPackConfig.cmake", "-G", "DEB", "-B", out], env=self.env)

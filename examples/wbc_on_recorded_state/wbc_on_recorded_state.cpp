@@ -64,7 +64,8 @@ double column(const Row& row, const std::string& name) {
 
 // The generalized coordinates in the order of mft::model::VectorQ (model/coordinates.hpp), as the rawlog names them.
 const char* const kQ[mft::model::kNq] = {"x", "z", "pitch", "q4", "q5", "q6", "q7", "q8", "q9", "q10", "q11"};
-const char* const kQd[mft::model::kNq] = {"xd", "zd", "pitchd", "qd4", "qd5", "qd6", "qd7", "qd8", "qd9", "qd10", "qd11"};
+const char* const kQd[mft::model::kNq] = {"xd",  "zd",  "pitchd", "qd4",  "qd5", "qd6",
+                                          "qd7", "qd8", "qd9",    "qd10", "qd11"};
 
 mft::model::RobotStateEstimate stateOf(const Row& row) {
   mft::model::RobotStateEstimate s;
@@ -141,7 +142,8 @@ int run(int argc, char** argv) {
     const char* status = ok ? "ok" : mft::wbc::toString(diag.safety_event);
     if (json) {
       char buf[512];
-      std::snprintf(buf, sizeof buf, "%s{\"tick\": %llu, \"tau\": [%.17g, %.17g, %.17g, %.17g], \"ok\": %s, \"status\": \"%s\"}",
+      std::snprintf(buf, sizeof buf,
+                    "%s{\"tick\": %llu, \"tau\": [%.17g, %.17g, %.17g, %.17g], \"ok\": %s, \"status\": \"%s\"}",
                     ticks_json.empty() ? "" : ", ", static_cast<unsigned long long>(cmd.tick), cmd.tau[0], cmd.tau[1],
                     cmd.tau[2], cmd.tau[3], ok ? "true" : "false", status);
       ticks_json += buf;

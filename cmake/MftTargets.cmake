@@ -16,18 +16,25 @@ function(mft_add_library name)
   cmake_parse_arguments(A "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${name} ${A_SOURCES})
   mft_target_settings(${name})
-  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  # Sources include "model/...", "wbc/qp/..." from the repository root; an install keeps that layout under
+  # <prefix>/include/mft (docs/library.md).
+  target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+                                            $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/mft>)
   target_link_libraries(${name} PUBLIC ${A_PUBLIC_DEPS} PRIVATE ${A_PRIVATE_DEPS})
 endfunction()
 
-# Executables land in <build>/bin so that tests and scripts find every tool in one place.
+# Executables land in <build>/bin so that tests and scripts find every tool in one place, and in <prefix>/bin
+# of an install unless NO_INSTALL (a tool that only makes sense in the source tree).
 function(mft_add_executable name)
-  cmake_parse_arguments(A "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(A "NO_INSTALL" "" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${A_SOURCES})
   mft_target_settings(${name})
   target_link_libraries(${name} PRIVATE ${A_DEPS})
   target_compile_definitions(${name} PRIVATE MFT_CONFIG_DIR="${MFT_CONFIG_DIR}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+  if(NOT A_NO_INSTALL)
+    install(TARGETS ${name} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
+  endif()
 endfunction()
 
 # Unit tests: mft_add_gtest(name LABEL label SOURCES ... DEPS ...)

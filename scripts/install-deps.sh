@@ -4,7 +4,7 @@
 set -euo pipefail
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config dpkg-dev
   libeigen3-dev libyaml-cpp-dev libode-dev
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools
   cyclonedds-dev cyclonedds-tools

@@ -5,6 +5,8 @@
 #include <functional>
 #include <string>
 
+#include "model/config/install_layout.hpp"  // the tools' data paths (configuration, scripts)
+
 namespace mft::config {
 
 // The text of a JSON string without the quotes: '"', '\\' and every control character escaped (RFC 8259),

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "model/config/install_layout.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "services/runtime/scenario_limits.hpp"
 
@@ -12,7 +13,7 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("domain", "DDS domain id (0..232)", "", true);
   cli.option("scenario", "scenario file (config/scenarios/*.yaml)", "", true);
   cli.option("mode", "lockstep | realtime", "lockstep");
-  cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");

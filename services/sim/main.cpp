@@ -55,7 +55,7 @@ sim::StandingPose initialPose(const services::Scenario& scenario) {
 int checkScenario(int argc, char** argv) {
   services::CommandLine cli("mft-sim --check-scenario", "Validate a scenario file (and its terrain) and exit.");
   cli.option("check-scenario", "the scenario file", "", true);
-  cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("profile", "configuration profile, after the scenario's (repeatable): checked against every "
              "configuration file");
   cli.flag("json", "print the scenario as JSON (its profiles: the scenario's, then --profile)");

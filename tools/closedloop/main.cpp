@@ -24,7 +24,7 @@ static int toolMain(int argc, char** argv) {
       "mapping and fall criteria. Without --scenario: stand at --height until --step-at, then step in place\n"
       "(--speed 0) or walk (--speed != 0). With --scenario the given options override the file's values.");
   cli.option("scenario", "scenario file (config/scenarios/*.yaml)");
-  cli.option("config-dir", "configuration folder", MFT_CONFIG_DIR);
+  cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, applied after the scenario's "
              "(repeatable, in order, or a comma list; docs/profiles.md)");
   cli.option("controller", "mft | sa | none (default: the scenario's, else mft)");

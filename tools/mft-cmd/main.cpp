@@ -89,7 +89,8 @@ static int toolMain(int argc, char** argv) {
   cli.option("timeout", "seconds to wait for a reader of the stack to match, and again for the acknowledgement", "5");
   cli.option("verdict-timeout", "seconds to wait for the stack's verdict once the command is written", "10");
   cli.flag("accepted-only", "return at the first acceptance (scheduled) instead of waiting until it is applied");
-  cli.option("profiles", "DDS QoS profile file", MFT_DDS_PROFILES);
+  cli.option("profiles", "DDS QoS profile file",
+             mft::config::dataFileFor("config/dds_profiles.xml", MFT_DDS_PROFILES));
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (secured stacks)");
   cli.option("identity", "with --secure: the identity to use", "cmd");
   cli.flag("json", "print one JSON object with the command, the verdicts and the result (also on failure)");

@@ -222,8 +222,9 @@ int exportMain(int argc, char** argv) {
   if (reader->end() == rawlog::RawlogReader::End::Truncated)
     std::fprintf(stderr, "mft-export: the file is truncated: read up to its last whole record\n");
   if (cli.isSet("plot") && reader->end() != rawlog::RawlogReader::End::Corrupt) {
-    const std::string cmd = "/usr/bin/python3 '" + std::string(MFT_PLOT_SCRIPT) + "' '" + csv_dir + "' '" +
-                            cli.get("plot") + "'" + (json ? " >&2" : "");
+    const std::string script = config::dataFileFor("scripts/mft-plot.py", MFT_PLOT_SCRIPT);
+    const std::string cmd = "/usr/bin/python3 '" + script + "' '" + csv_dir + "' '" + cli.get("plot") + "'" +
+                            (json ? " >&2" : "");
     const int rc = std::system(cmd.c_str());
     if (rc != 0) {
       std::fprintf(stderr, "mft-export: plotting failed (%s)\n", cmd.c_str());

@@ -403,7 +403,8 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
   // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/videos.md).
   std::signal(SIGPIPE, SIG_IGN);  // a renderer that died shows as a failed write, not as our death
   services::installShutdownHandlers();
-  const std::string cmd = "/usr/bin/python3 " + shellQuote(MFT_VIDEO_SCRIPT);
+  const std::string script = config::dataFileFor("scripts/mft-video.py", MFT_VIDEO_SCRIPT);
+  const std::string cmd = "/usr/bin/python3 " + shellQuote(script);
   std::FILE* renderer = ::popen(cmd.c_str(), "w");
   if (!renderer) {
     removeTmp();

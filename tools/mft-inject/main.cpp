@@ -324,7 +324,8 @@ static int toolMain(int argc, char** argv) {
   cli.option("wait-match", "seconds to wait for a matching reader before publishing (0: do not wait)", "5");
   cli.option("wait-writers", "with --listen: seconds to wait until every listened topic has a matched writer before "
              "the --seconds window starts (0: do not wait)", "0");
-  cli.option("profiles", "DDS QoS profile file", MFT_DDS_PROFILES);
+  cli.option("profiles", "DDS QoS profile file",
+             mft::config::dataFileFor("config/dds_profiles.xml", MFT_DDS_PROFILES));
   cli.flag("json", "print the report as JSON");
   cli.parse(argc, argv);
 

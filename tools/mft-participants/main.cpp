@@ -101,7 +101,8 @@ int toolMain(int argc, char** argv) {
       "participant discovery for --wait-ms and prints every participant it discovered (name, GUID prefix,\n"
       "addresses). The supervisor uses it to refuse a domain that is already in use.");
   cli.option("domain", "DDS domain id (0..232)", "", true);
-  cli.option("profiles", "DDS QoS profile file (its participant profile mft_participant is used)", MFT_DDS_PROFILES);
+  cli.option("profiles", "DDS QoS profile file (its participant profile mft_participant is used)",
+             mft::config::dataFileFor("config/dds_profiles.xml", MFT_DDS_PROFILES));
   cli.option("wait-ms", "how long to listen for participants [ms] (docs/faults.md: discovery on loopback took "
              "92-368 ms on a loaded 2-core VM)", "1000");
   cli.flag("stop-at-first", "return as soon as one participant is discovered");

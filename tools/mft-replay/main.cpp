@@ -378,7 +378,8 @@ static int toolMain(int argc, char** argv) {
   std::unique_ptr<services::DdsParticipant> participant;
   try {
     participant = std::make_unique<services::DdsParticipant>(static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId)),
-                                                             MFT_DDS_PROFILES, "mft-replay");
+                                                             config::dataFileFor("config/dds_profiles.xml", MFT_DDS_PROFILES),
+                                                             "mft-replay");
   } catch (const services::DdsError& e) {
     cli.fail(e.what());
   }

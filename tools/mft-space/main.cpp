@@ -33,12 +33,12 @@ commands
   all      fit + figure + stance table into --out DIR (mft_space.yaml, mft_space.png, stance.txt)
 
 common options
-  --robot FILE        robot description (default: )" MFT_CONFIG_DIR R"(/robot.yaml)
+  --robot FILE        robot description (default: <config>/robot.yaml)
   --json              machine-readable output on stdout (progress stays on stderr)
   --quiet             no progress on stderr
 
 fit / all
-  --output FILE       polytope YAML (fit default: )" MFT_CONFIG_DIR R"(/mft_space.yaml; all: also DIR/mft_space.yaml)
+  --output FILE       polytope YAML (fit default: <config>/mft_space.yaml; all: also DIR/mft_space.yaml)
   --out DIR           (all) output folder, created if missing
   --joint-step RAD    joint-space grid step (default 0.01)
   --cart-step M       Cartesian grid step (default 0.01 = the paper's 10 x 10 mm)
@@ -51,15 +51,27 @@ index / fit / all (thresholds and RACI)
   --raci-form F       optimal (default, optimal gear ratio) or fixed (k = n sqrt(J_m) of the actuator)
   --drive-k K         override k for the fixed form       --gravity   include gravity in RACI
 figure / stance
-  --polytope FILE     stored polytope (default: )" MFT_CONFIG_DIR R"(/mft_space.yaml)
+  --polytope FILE     stored polytope (default: <config>/mft_space.yaml)
   --png FILE          (figure) output PNG (default mft_space.png)
   --from M --to M --step M     (stance) base heights (default 0.38 .. 0.46 step 0.01)
 index
   --rear Q4 --fore Q6 actuated hip angles [rad] (required)
 )";
 
-std::string defaultRobot() { return std::string(MFT_CONFIG_DIR) + "/robot.yaml"; }
-std::string defaultPolytope() { return std::string(MFT_CONFIG_DIR) + "/mft_space.yaml"; }
+// The configuration folder of this executable: the source tree's, or <prefix>/share/mft_wbc/config installed.
+std::string configDir() { return mft::config::configDirFor(MFT_CONFIG_DIR); }
+std::string defaultRobot() { return configDir() + "/robot.yaml"; }
+std::string defaultPolytope() { return configDir() + "/mft_space.yaml"; }
+std::string figureScript() { return mft::config::dataFileFor("scripts/mft_space_figure.py", MFT_SPACE_FIGURE_SCRIPT); }
+
+// kUsage with <config> replaced by the configuration folder.
+std::string usage() {
+  std::string text = kUsage;
+  const std::string token = "<config>";
+  for (std::size_t at = text.find(token); at != std::string::npos; at = text.find(token, at))
+    text.replace(at, token.size(), configDir());
+  return text;
+}
 
 std::set<std::string> withSpaceOptions(std::set<std::string> s) {
   for (int i = 0; kSpaceOptions[i]; ++i) s.insert(kSpaceOptions[i]);
@@ -138,7 +150,7 @@ int cmdFigure(int argc, char** argv) {
   const std::string data = pngDataPath(png);
   writeFigureData(data, figureInput(joint, cart, p, robot));
   progress.stage("drawing " + png);
-  const std::string why = drawFigure(data, png, MFT_SPACE_FIGURE_SCRIPT);
+  const std::string why = drawFigure(data, png, figureScript());
   if (a.flag("json"))
     std::cout << JsonObject().str("png", png).str("data", data).boolean("drawn", why.empty()).str("error", why).str()
               << "\n";
@@ -197,7 +209,7 @@ int cmdAll(int argc, char** argv) {
   const std::string png = dir + "/mft_space.png", data = dir + "/mft_space_data.json";
   writeFigureData(data, figureInput(r.joint, r.cartesian, r.polytope, robot));
   progress.stage("drawing " + png);
-  const std::string why = drawFigure(data, png, MFT_SPACE_FIGURE_SCRIPT);
+  const std::string why = drawFigure(data, png, figureScript());
   if (!why.empty()) std::cerr << "mft-space: WARNING: " << why << "\n";
 
   const auto rows = stanceTable(robot, s.criteria, r.polytope.leg, from, to, step);
@@ -229,12 +241,12 @@ int cmdAll(int argc, char** argv) {
 
 static int toolMain(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "mft-space: missing command\n" << kUsage;
+    std::cerr << "mft-space: missing command\n" << usage();
     return 2;
   }
   const std::string cmd = argv[1];
   if (cmd == "--help" || cmd == "-h" || cmd == "help") {
-    std::cout << kUsage;
+    std::cout << usage();
     return 0;
   }
   try {

@@ -59,11 +59,21 @@ class LiveTuning {
         lockstep_(lockstep),
         status_file_(status_file),
         judge_(std::move(judge)),
-        verdicts_(participant, service, verdict_source),
-        applied_writer_(participant, "ConfigChange", "verdict_writer") {
+        verdicts_(participant, service, verdict_source) {
+    // A secured stack whose permissions predate ConfigChange runs on without live tuning, with a warning.
+    try {
+      applied_writer_ = std::make_unique<TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>>(
+          participant, "ConfigChange", "verdict_writer");
+    } catch (const DdsError& e) {
+      std::fprintf(stderr, "%s: warning: %s: applied live changes are not published (nor recorded)\n", service_, e.what());
+    }
     worker_ = std::thread([this] { run(); });
-    reader_ = std::make_unique<TopicReader<msg::ConfigChange, msg::ConfigChangePubSubType>>(
-        participant, "ConfigChange", "event_reader", [this](const msg::ConfigChange& m) { onRequest(m); });
+    try {
+      reader_ = std::make_unique<TopicReader<msg::ConfigChange, msg::ConfigChangePubSubType>>(
+          participant, "ConfigChange", "event_reader", [this](const msg::ConfigChange& m) { onRequest(m); });
+    } catch (const DdsError& e) {
+      std::fprintf(stderr, "%s: warning: %s: no live tuning\n", service_, e.what());
+    }
     writeStatus();  // an empty list: status shows that this service takes live changes
   }
   ~LiveTuning() {
@@ -74,7 +84,7 @@ class LiveTuning {
     }
     wake_.notify_all();
     worker_.join();
-    applied_writer_.waitForAcknowledgments(std::chrono::milliseconds(1000));
+    if (applied_writer_) applied_writer_->waitForAcknowledgments(std::chrono::milliseconds(1000));
   }
   LiveTuning(const LiveTuning&) = delete;
   LiveTuning& operator=(const LiveTuning&) = delete;
@@ -199,7 +209,7 @@ class LiveTuning {
       done_head_ = (done_head_ + 1) % done_.size();
       --done_count_;
       lock.unlock();
-      applied_writer_.write(p.record);
+      if (applied_writer_) applied_writer_->write(p.record);
       const double time_s = static_cast<double>(p.record.stamp_ns()) * 1e-9;
       std::printf("%s: live change seq %llu applied at tick %llu (t = %.3f s): %s = %s (was %s)\n", service_,
                   static_cast<unsigned long long>(p.record.seq()), static_cast<unsigned long long>(p.record.tick()),
@@ -228,7 +238,7 @@ class LiveTuning {
   std::string status_file_;
   Judge judge_;
   VerdictPublisher verdicts_;
-  TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType> applied_writer_;
+  std::unique_ptr<TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>> applied_writer_;
   std::unique_ptr<TopicReader<msg::ConfigChange, msg::ConfigChangePubSubType>> reader_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -43,7 +43,12 @@ def export(rawlog, out, labels):
                        capture_output=True, text=True, timeout=300)
     if p.returncode != 0:
         raise AssertionError(f"mft-export {rawlog}: exit {p.returncode}: {p.stderr}")
-    return {label: list(csv.DictReader(open(out / f"{label}.csv"))) for label in labels}
+    tables = {}
+    for label in labels:  # a label without observations gets no file
+        path = out / f"{label}.csv"
+        with open(path) if path.exists() else open("/dev/null") as f:
+            tables[label] = list(csv.DictReader(f))
+    return tables
 
 
 def by_tick(rows, column):
@@ -77,9 +82,16 @@ class LiveTuningInLockstep(unittest.TestCase):
         code, cls.plain_summary, err = cls.stacks.run_json(cls.scenario, DOMAIN_LOCKSTEP, "--record", cls.plain,
                                                            timeout=600)
         assert code == 0, f"plain run: exit {code}: {err[-3000:]}"
-        # The same run with the change sent while it runs (mft-cmd waits for the stack's readers to match).
+        # The same run with the change sent while it runs. mft-cmd starts once mft-wbc has created its live-tuning
+        # endpoints (it writes its empty mft-wbc.tuning.json then): earlier, the supervisor's busy-domain probe would
+        # see mft-cmd's participant and refuse the domain.
         proc = cls.stacks.start_run(cls.scenario, DOMAIN_LOCKSTEP, "--record", cls.tuned)
         cls.tuned_run_dir = proc.run_dir
+        deadline = time.monotonic() + 120
+        while not (proc.run_dir / "mft-wbc.tuning.json").exists():
+            assert proc.poll() is None, f"the tuned run ended before mft-wbc was up: {proc.communicate()[1][-3000:]}"
+            assert time.monotonic() < deadline, "mft-wbc did not come up within 120 s"
+            time.sleep(0.05)
         cls.set_result = mft_cmd(DOMAIN_LOCKSTEP, "--set", f"wbc.gains.base_z.kp={KP_AFTER:g}", "--at", AT_S,
                                  "--timeout", 60, "--verdict-timeout", 60)
         # Refused by a lockstep stack: a change without a stated time, and one at a time already passed.

@@ -121,7 +121,7 @@ static int runSet(const services::CommandLine& cli) {
   }
 
   int matched = 0;
-  bool acknowledged = true;
+  bool acknowledged = false;
   auto finish = [&](int code, const std::string& result, const std::string& error) {
     if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
     if (json) {
@@ -166,18 +166,29 @@ static int runSet(const services::CommandLine& cli) {
           v.waited_s = std::chrono::duration<double>(Clock::now() - written_at[i]).count();
           received[i].push_back(v);
         });
-    services::TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType> writer(participant, "ConfigChange",
-                                                                                 "command_writer");
-    if (!services::waitUntil([&] { return writer.matched() > 0; }, timeout))
+    // One writer per change: the command writer keeps one sample (KEEP_LAST 1, transient local), so a reader that
+    // matches only after the writes (discovery reports the WBC's and the planner's readers one at a time) still
+    // gets every change, not only the last one.
+    using Writer = services::TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>;
+    std::vector<std::unique_ptr<Writer>> writers;
+    for (std::size_t i = 0; i < changes.size(); ++i)
+      writers.push_back(std::make_unique<Writer>(participant, "ConfigChange", "command_writer"));
+    const auto all_matched = [&] {
+      for (const auto& w : writers)
+        if (w->matched() == 0) return false;
+      return true;
+    };
+    if (!services::waitUntil(all_matched, timeout))
       return finish(kNoStack, "no_stack",
                     "no stack answered on domain " + std::to_string(domain) + " within " + fmt(timeout_s, -6) +
                         " s (no reader of ConfigChange; is the stack up on this domain?)");
+    acknowledged = true;  // every write's acknowledgement, below
     for (std::size_t i = 0; i < changes.size(); ++i) {
       written_at[i] = Clock::now();
-      if (!writer.write(changes[i].msg)) return finish(kUsage, "error", "the DDS writer refused the ConfigChange");
-      acknowledged = writer.waitForAcknowledgments(timeout) && acknowledged;
+      if (!writers[i]->write(changes[i].msg)) return finish(kUsage, "error", "the DDS writer refused the ConfigChange");
     }
-    matched = writer.matched();
+    for (const auto& w : writers) acknowledged = w->waitForAcknowledgments(timeout) && acknowledged;
+    matched = writers.front()->matched();
     if (!json) {
       std::printf("mft-cmd: %zu ConfigChange(s) (%s) written to %d reader(s) on domain %d, %s\n", changes.size(),
                   at_s > 0 ? ("at t = " + fmt(at_s, 3) + " s").c_str() : "at the next tick", matched, domain,

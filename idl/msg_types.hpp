@@ -16,7 +16,8 @@
   X(WbcDiagnostics)      \
   X(RecorderProgress)    \
   X(Disturbance)         \
-  X(CommandVerdict)
+  X(CommandVerdict)      \
+  X(ConfigChange)
 
 namespace mft::msg {
 #define MFT_MSG_TYPE_ALIAS(Name) using Name = dds_::Name##_;

@@ -13,6 +13,7 @@
 #include "planner/plan_output.hpp"
 #include "planner/planner_config.hpp"
 #include "planner/planner_state.hpp"
+#include "planner/planner_tuning.hpp"
 
 namespace mft::planner {
 
@@ -31,6 +32,14 @@ class MotionPlanner {
   const PlanOutput& update(const PlannerState& state);
 
   void reset() { started_ = false; }
+
+  // Live tuning: swing, foot placement and height rate from the next update() on (copies doubles: allocation-free,
+  // for a tick boundary). Judge a change with applyPlannerOverride first (planner_tuning.hpp).
+  void setTuning(const PlannerTuning& t) {
+    config_.swing = t.swing;
+    config_.placement = t.placement;
+    config_.command.height_rate_mps = t.height_rate_mps;
+  }
   const PlanOutput& output() const { return out_; }
   const ContactSchedule& schedule() const { return schedule_; }
   const PlannerConfig& config() const { return config_; }

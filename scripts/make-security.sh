@@ -10,11 +10,12 @@
 # shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/security.md).
 # Permissions: each service may publish only its own topics; only the sim publishes SensorData/GroundTruth,
 # only the WBC JointCommand; the recorder subscribes to every topic and publishes only its RecorderProgress (lockstep flow control); cmd publishes
-# OperatorCommand and Disturbance only and reads the CommandVerdict the planner and the sim answer with.
+# OperatorCommand, Disturbance and ConfigChange only and reads the CommandVerdict the planner, the WBC and the sim
+# answer with (the planner and the WBC publish the ConfigChange they applied, for the recorder).
 set -euo pipefail
 
 usage() {
-  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
   echo
   echo "Options:"
   echo "  --profile data   governance with data-only ENCRYPT on every topic, discovery and liveliness encrypted,"
@@ -64,21 +65,21 @@ umask 077
 cd "$DIR"
 
 IDENTITIES=(sim estimator planner wbc record cmd)
-ALL_TOPICS=(SensorData GroundTruth RobotState OperatorCommand Reference JointCommand WbcDiagnostics Disturbance)
+ALL_TOPICS=(SensorData GroundTruth RobotState OperatorCommand Reference JointCommand WbcDiagnostics Disturbance ConfigChange)
 # Who may publish / subscribe what (docs/architecture.md#topics; mft-cmd publishes operator commands and pushes).
 declare -A PUB=(
   [sim]="SensorData GroundTruth CommandVerdict"
   [estimator]="RobotState"
-  [planner]="Reference CommandVerdict"
-  [wbc]="JointCommand WbcDiagnostics"
+  [planner]="Reference CommandVerdict ConfigChange"
+  [wbc]="JointCommand WbcDiagnostics CommandVerdict ConfigChange"
   [record]="RecorderProgress"
-  [cmd]="OperatorCommand Disturbance"
+  [cmd]="OperatorCommand Disturbance ConfigChange"
 )
 declare -A SUB=(
   [sim]="JointCommand Disturbance RecorderProgress"
   [estimator]="SensorData GroundTruth"
-  [planner]="RobotState OperatorCommand"
-  [wbc]="RobotState Reference"
+  [planner]="RobotState OperatorCommand ConfigChange"
+  [wbc]="RobotState Reference ConfigChange"
   [record]="${ALL_TOPICS[*]}"
   [cmd]="CommandVerdict"
 )

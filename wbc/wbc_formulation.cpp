@@ -17,10 +17,13 @@ double pdAcceleration(const Setpoint1& ref, double pos, double vel, const PdGain
   return ref.acc + g.kp * (ref.pos - pos) + g.kd * (ref.vel - vel);
 }
 
-// Floating-base coordinate task (height or pitch): J = unit row, Jdot qd = 0.
-Task baseCoordinateTask(const char* name, int index, double weight, const Setpoint1 WbcReference::*ref_member,
-                        const PdGains1 WbcGains::*gains_member) {
-  return Task(name, VarBlock::Qdd, 1, weight, [index, ref_member, gains_member](const TickContext& c, Task* t) {
+// Floating-base coordinate task (height or pitch): J = unit row, Jdot qd = 0. Weights and gains are read from
+// the parameters at every tick, so a live change (WholeBodyController::setTuning) acts from the next tick.
+Task baseCoordinateTask(const char* name, int index, const WbcWeights& w, double WbcWeights::*weight_member,
+                        const Setpoint1 WbcReference::*ref_member, const PdGains1 WbcGains::*gains_member) {
+  return Task(name, VarBlock::Qdd, 1, w.*weight_member,
+              [index, weight_member, ref_member, gains_member](const TickContext& c, Task* t) {
+    t->weight = c.params->weights.*weight_member;
     t->A.setZero();
     t->A(0, index) = 1.0;
     t->b(0) = pdAcceleration(c.ref->*ref_member, c.state->q[index], c.state->qd[index], c.params->gains.*gains_member);
@@ -29,10 +32,10 @@ Task baseCoordinateTask(const char* name, int index, double weight, const Setpoi
 
 // Base x task for standing: J = unit row, weight w_x only while the planner holds base x (Stand mode) and both
 // feet are in stance, 0 otherwise (stepping leaves base x passive, as in the paper).
-Task baseXTask(double weight) {
-  return Task("base_x", VarBlock::Qdd, 1, 0.0, [weight](const TickContext& c, Task* t) {
+Task baseXTask() {
+  return Task("base_x", VarBlock::Qdd, 1, 0.0, [](const TickContext& c, Task* t) {
     const bool active = c.ref->hold_base_x && c.ref->foot_in_stance[0] && c.ref->foot_in_stance[1];
-    t->weight = active ? weight : 0.0;
+    t->weight = active ? c.params->weights.base_x : 0.0;
     t->A.setZero();
     t->A(0, model::kBaseX) = 1.0;
     t->b(0) = active ? pdAcceleration(c.ref->base_x, c.state->q[model::kBaseX], c.state->qd[model::kBaseX],
@@ -59,8 +62,10 @@ Task footTask(const char* name, int leg) {
 }
 
 // weight * || x_block - target ||^2 with an identity A (keeps the f_c / eps parts of H diagonal).
-Task identityTask(const char* name, VarBlock block, double weight, bool track_fc_prev) {
-  Task t(name, block, blockSize(block), weight, [track_fc_prev](const TickContext& c, Task* task) {
+Task identityTask(const char* name, VarBlock block, const WbcWeights& w, double WbcWeights::*weight_member,
+                  bool track_fc_prev) {
+  Task t(name, block, blockSize(block), w.*weight_member, [weight_member, track_fc_prev](const TickContext& c, Task* task) {
+    task->weight = c.params->weights.*weight_member;
     if (track_fc_prev) task->b = c.fc_prev;
   });
   t.A.setIdentity();
@@ -111,23 +116,23 @@ Formulation buildFormulation(const WbcParams& params) {
 
   // --- Cost, eq. 15 ---
   // 15a: operational-space tracking through the PD law of eq. 17.
-  f.tasks.push_back(baseCoordinateTask("base_z", model::kBaseZ, w.base_z, &WbcReference::base_z, &WbcGains::base_z));
+  f.tasks.push_back(baseCoordinateTask("base_z", model::kBaseZ, w, &WbcWeights::base_z, &WbcReference::base_z, &WbcGains::base_z));
   f.tasks.push_back(
-      baseCoordinateTask("base_pitch", model::kBasePitch, w.base_pitch, &WbcReference::base_pitch, &WbcGains::base_pitch));
+      baseCoordinateTask("base_pitch", model::kBasePitch, w, &WbcWeights::base_pitch, &WbcReference::base_pitch, &WbcGains::base_pitch));
   f.tasks.push_back(footTask("foot_right", model::kRightLeg));
   f.tasks.push_back(footTask("foot_left", model::kLeftLeg));
   // 15b: contact force regularization and rate penalty ||f_c - f_c^-||.
-  f.tasks.push_back(identityTask("contact_force", VarBlock::Fc, w.contact_force, false));
-  f.tasks.push_back(identityTask("contact_force_rate", VarBlock::Fc, w.contact_force_rate, true));
+  f.tasks.push_back(identityTask("contact_force", VarBlock::Fc, w, &WbcWeights::contact_force, false));
+  f.tasks.push_back(identityTask("contact_force_rate", VarBlock::Fc, w, &WbcWeights::contact_force_rate, true));
   // 15c: slack of the MFT soft constraint (kept in every variant so H stays positive definite; eps is fixed
   // to 0 by its bounds when there is no MFT row).
-  f.tasks.push_back(identityTask("slack", VarBlock::Eps, w.slack, false));
+  f.tasks.push_back(identityTask("slack", VarBlock::Eps, w, &WbcWeights::slack, false));
   // Not in the paper: a small ||qdd||^2 term. The tasks above constrain only 6 of the 11 accelerations; the
   // rest would be fixed by the equalities alone, and the dual active-set solver needs H positive definite.
-  f.tasks.push_back(identityTask("qdd_regularization", VarBlock::Qdd, w.qdd_regularization, false));
+  f.tasks.push_back(identityTask("qdd_regularization", VarBlock::Qdd, w, &WbcWeights::qdd_regularization, false));
   // Not in the paper: base x while standing in double support (eq. 12 plans only z and pitch). Last, so the
   // indices of the paper's terms stay as they were.
-  f.tasks.push_back(baseXTask(w.base_x));
+  f.tasks.push_back(baseXTask());
 
   // --- Constraints, eq. 16 and the loop closure ---
   using Type = Constraint::Type;

@@ -25,6 +25,7 @@
 #include "wbc/wbc_dynamics.hpp"
 #include "wbc/wbc_formulation.hpp"
 #include "wbc/wbc_reference.hpp"
+#include "wbc/wbc_tuning.hpp"
 
 namespace mft::wbc {
 
@@ -46,6 +47,14 @@ class WholeBodyController {
 
   // Leaves a latched damping state and restarts the contact-force history.
   void resetSafety();
+
+  // Live tuning: the weights and gains from the next update() on (copies doubles: allocation-free, for a tick
+  // boundary). Judge a change with applyWbcOverride first (wbc_tuning.hpp).
+  void setTuning(const WbcTuning& tuning) {
+    params_.weights = tuning.weights;
+    params_.gains = tuning.gains;
+  }
+  WbcTuning tuning() const { return {params_.weights, params_.gains}; }
 
   const WbcParams& params() const { return params_; }
   WbcVariant variant() const { return params_.variant; }

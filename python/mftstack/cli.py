@@ -242,7 +242,8 @@ def cmd_status(args):
                 for n, p in st["services"].items()}
     out = {"domain": args.domain, "supervisor_pid": st["supervisor_pid"], "supervisor_alive": pid_alive(st["supervisor_pid"]),
            "scenario": st["scenario"], "mode": st["mode"], "run_dir": st["run_dir"], "services": services,
-           "uptime_s": round(time.time() - st["started"], 1), "stack": st.get("stack")}
+           "uptime_s": round(time.time() - st["started"], 1), "stack": st.get("stack"),
+           "live_changes": live_changes(Path(st["run_dir"]))}
     if args.json:
         print(json.dumps(out, indent=2))
     else:
@@ -253,7 +254,25 @@ def cmd_status(args):
         for n, s in services.items():
             where = f"  on {s['host']}" if s.get("host") else ""
             print(f"  {n:{16 if hosts else 14}s} pid {s['pid']:<8d} {'running' if s['alive'] else 'not running'}{where}")
+        for n, changes in out["live_changes"].items():
+            for c in changes:
+                print(f"  live change    {n}: {c['key']} = {c['value']} (was {c['previous']}) from tick {c['tick']} "
+                      f"(t = {c['time_s']:.3f} s), seq {c['seq']}")
     return 0 if out["supervisor_alive"] else 1
+
+
+def live_changes(run_dir):
+    """The changes mft-cmd --set made while the stack runs, per service, oldest first: mft-wbc and mft-planner
+    list them in <run_dir>/<service>.tuning.json, rewritten (whole) by a thread of the service after each change
+    (docs/live-tuning.md). A service that takes none has an empty list; one without the file is not listed."""
+    out = {}
+    for path in sorted(Path(run_dir).glob("*.tuning.json")):
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue  # being replaced: the next status reads it whole
+        out[data.get("service", path.name[:-len(".tuning.json")])] = data.get("applied", [])
+    return out
 
 
 def cmd_down(args):

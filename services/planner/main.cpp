@@ -16,6 +16,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/live_tuning.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
@@ -57,8 +58,10 @@ static int toolMain(int argc, char** argv) {
   services::ServiceContext ctx("mft-planner", cli);
 
   planner::PlannerConfig config;
+  std::string config_text;  // the base of live changes (docs/live-tuning.md)
   try {
     config = planner::loadPlannerConfig(ctx.configFile("planner.yaml"));
+    config_text = services::configTextInForce(ctx.configFile("planner.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }
@@ -91,6 +94,16 @@ static int toolMain(int argc, char** argv) {
   std::size_t pending_count = 0;
   std::uint64_t operator_received = 0, operator_rejected = 0, operator_applied = 0;
   services::VerdictPublisher verdicts(ctx.participant(), "mft-planner", msg::COMMAND_SOURCE_PLANNER);
+  // Live tuning (mft-cmd --set planner.<key>=<value>): judged off the loop by planner.yaml's strict loader, applied
+  // at the tick boundary below (after the operator commands of the tick, before its plan).
+  using Tuning = services::LiveTuning<planner::PlannerTuning>;
+  Tuning tuning(ctx.participant(), "mft-planner", msg::CONFIG_TARGET_PLANNER, msg::COMMAND_SOURCE_PLANNER,
+                ctx.lockstep(), services::tuningStatusFile(cli.get("summary")), config_text,
+                [](const std::string& text, const std::string& key, const std::string& value) {
+                  auto o = planner::applyPlannerOverride(text, "planner.yaml (live change)", key, value);
+                  return Tuning::Judged{planner::tuningOf(o.config), std::move(o.yaml_text), std::move(o.value),
+                                        std::move(o.previous)};
+                });
 
   auto apply = [&](const planner::OperatorCommand& cmd, const char* origin) {
     const auto result = planner.setCommand(cmd);
@@ -144,6 +157,8 @@ static int toolMain(int argc, char** argv) {
                         p.cmd.z_cmd, p.cmd.v_cmd, static_cast<unsigned long long>(m.tick()), state.time_s);
         }
         pending_count = 0;
+        tuning.applyDue(m.tick(), state.time_s, m.stamp_ns(),
+                        [&](const planner::PlannerTuning& t) { planner.setTuning(t); });
         const auto& plan = planner.update(state_builder.build(state));
         services::toMsg(plan, &out_msg);
         out_msg.tick(m.tick());
@@ -199,7 +214,7 @@ static int toolMain(int argc, char** argv) {
                 pending_count, static_cast<unsigned long long>(refused_inputs),
                 static_cast<unsigned long long>(gate.refused()), static_cast<unsigned long long>(gate.newClocks()),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
-  ctx.writeSummary(std::string(buf) + update_us.json() + "}");
+  ctx.writeSummary(std::string(buf) + update_us.json() + ", \"live_changes\": " + tuning.summaryJson() + "}");
   return 0;
 }
 

@@ -402,6 +402,8 @@ static int toolMain(int argc, char** argv) {
     Subscription<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> r5(p, "WbcDiagnostics", chain, recorder, be);
     Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> r6(p, "OperatorCommand", "event_reader", recorder);
     Subscription<msg::Disturbance, msg::DisturbancePubSubType> r7(p, "Disturbance", "event_reader", recorder);
+    // Live tuning: the requests and the changes the WBC and the planner applied, with their ticks (label config_change).
+    Subscription<msg::ConfigChange, msg::ConfigChangePubSubType> r8(p, "ConfigChange", "event_reader", recorder);
     // Not recorded: CommandVerdict (the stack's answer to mft-cmd). Its reason is text, which rawlog schema 1's
     // numeric channels cannot hold, and a new topic would change the schema that older recordings and tools
     // share; the commands themselves are recorded above, and each verdict (with the tick a command was applied

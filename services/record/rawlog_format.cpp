@@ -4,8 +4,13 @@
 #include <mrpt/obs/CObservationRawDAQ.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <stdexcept>
+
+#include "model/config/live_tuning.hpp"
 
 namespace mft::rawlog {
 
@@ -17,7 +22,8 @@ namespace {
 constexpr std::int64_t kFiletimeUnixOffset100ns = 116444736000000000LL;  // 1601-01-01 -> 1970-01-01
 
 const char* const kTopicNames[kNumTopics] = {"GroundTruth",  "SensorData",     "RobotState",      "Reference",
-                                             "JointCommand", "WbcDiagnostics", "OperatorCommand", "Disturbance"};
+                                             "JointCommand", "WbcDiagnostics", "OperatorCommand", "Disturbance",
+                                             "ConfigChange"};
 
 std::vector<std::string> withTick(std::vector<std::string> cols) {
   cols.insert(cols.begin(), "tick");
@@ -101,6 +107,13 @@ std::vector<LabelSpec> makeLabels() {
                {"-", "m", "m/s", "-"}, "operator command (mode 0 stand, 1 step in place, 2 walk)"});
   l.push_back({"disturbance", Topic::Disturbance, LabelClass::RawDaq, {"seq", "impulse_Ns", "trigger", "time_s", "leg"},
                {"-", "N s", "-", "s", "-"}, "push request (trigger 0 at time, 1 at next lift-off of leg)"});
+  // Appended after schema 1's first labels: a reader that predates it ignores the label (counted as unknown).
+  l.push_back({"config_change", Topic::ConfigChange, LabelClass::RawDaq,
+               {"seq", "applied", "target", "key", "at_s", "tick", "count", "value_0", "value_1"},
+               {"-", "0/1", "-", "-", "s", "-", "-", "-", "-"},
+               "live tuning (mft-cmd --set): a request (applied 0) or a change in force from tick (applied 1); target "
+               "0 wbc.yaml, 1 planner.yaml; key = index in model/config/live_tuning.cpp tunableKeys() (-1: not "
+               "tunable); value_0/value_1 the value as loaded (count of them), requests hold none"});
   return l;
 }
 
@@ -216,6 +229,20 @@ void toChannels(const Message& m, const std::string& label, double* p) {
       *p++ = d.leg();
       break;
     }
+    case Topic::ConfigChange: {
+      const auto& c = std::get<msg::ConfigChange>(m);
+      const std::string key(c.key().data(), strnlen(c.key().data(), c.key().size()));
+      *p++ = static_cast<double>(c.seq());
+      *p++ = b2d(c.applied());
+      *p++ = static_cast<double>(c.target());
+      *p++ = static_cast<double>(
+          config::tunableIndex(c.target() == msg::CONFIG_TARGET_PLANNER ? "planner" : "wbc", key));
+      *p++ = c.at_s();
+      *p++ = static_cast<double>(c.tick());
+      *p++ = static_cast<double>(c.count());
+      put(p, c.number());
+      break;
+    }
   }
 }
 
@@ -319,6 +346,25 @@ void fromChannels(const std::string& label, const double* p, Message* m) {
       d.leg(static_cast<std::int16_t>(*p++));
       break;
     }
+    case Topic::ConfigChange: {
+      auto& c = std::get<msg::ConfigChange>(*m);
+      c.seq(d2u(*p++));
+      c.applied(d2b(*p++));
+      c.target(static_cast<std::uint8_t>(*p++));
+      const double key = *p++;
+      const auto& keys = config::tunableKeys();
+      c.key().fill('\0');
+      if (key >= 0.0 && key < static_cast<double>(keys.size()))
+        std::snprintf(c.key().data(), c.key().size(), "%s", keys[static_cast<std::size_t>(key)].key);
+      c.at_s(*p++);
+      c.tick(d2u(*p++));
+      c.count(static_cast<std::uint8_t>(*p++));
+      get(p, c.number());
+      const std::string value = config::formatNumbers(c.number().data(), std::min<std::size_t>(c.count(), 2));
+      c.value().fill('\0');
+      if (c.count() > 0) std::snprintf(c.value().data(), c.value().size(), "%s", value.c_str());
+      break;
+    }
   }
 }
 
@@ -332,6 +378,7 @@ Message emptyMessage(Topic t) {
     case Topic::WbcDiagnostics: return msg::WbcDiagnostics();
     case Topic::OperatorCommand: return msg::OperatorCommand();
     case Topic::Disturbance: return msg::Disturbance();
+    case Topic::ConfigChange: return msg::ConfigChange();
   }
   return msg::GroundTruth();
 }
@@ -340,7 +387,9 @@ void setStamp(Message* m, std::uint64_t stamp_ns) {
   std::visit(
       [stamp_ns](auto& x) {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (!std::is_same_v<T, msg::OperatorCommand> && !std::is_same_v<T, msg::Disturbance>) x.stamp_ns(stamp_ns);
+        if constexpr (!std::is_same_v<T, msg::OperatorCommand> && !std::is_same_v<T, msg::Disturbance> &&
+                      !std::is_same_v<T, msg::ConfigChange>)
+          x.stamp_ns(stamp_ns);
       },
       *m);
 }
@@ -362,7 +411,9 @@ std::uint64_t tickOf(const Message& m) {
   return std::visit(
       [](const auto& x) -> std::uint64_t {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance>) return x.seq();
+        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance> ||
+                      std::is_same_v<T, msg::ConfigChange>)
+          return x.seq();
         else return x.tick();
       },
       m);
@@ -372,7 +423,9 @@ std::uint64_t stampOf(const Message& m) {
   return std::visit(
       [](const auto& x) -> std::uint64_t {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance>) return 0;
+        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance> ||
+                      std::is_same_v<T, msg::ConfigChange>)
+          return 0;
         else return x.stamp_ns();
       },
       m);

@@ -34,8 +34,9 @@ enum class Topic : std::uint8_t {
   WbcDiagnostics,
   OperatorCommand,
   Disturbance,
+  ConfigChange,  // live tuning (docs/live-tuning.md): requests and the changes the services applied
 };
-constexpr std::size_t kNumTopics = 8;
+constexpr std::size_t kNumTopics = 9;
 const char* topicName(Topic t);
 bool parseTopic(const std::string& name, Topic* out);
 // Topics whose messages carry tick and stamp_ns (the others are events, stamped on arrival).
@@ -43,7 +44,7 @@ inline bool hasTick(Topic t) { return t <= Topic::WbcDiagnostics; }
 
 // Variant index == Topic value.
 using Message = std::variant<msg::GroundTruth, msg::SensorData, msg::RobotState, msg::Reference, msg::JointCommand,
-                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance>;
+                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance, msg::ConfigChange>;
 inline Topic topicOf(const Message& m) { return static_cast<Topic>(m.index()); }
 // tick (or seq for events) and stamp_ns of a message (0 for events).
 std::uint64_t tickOf(const Message& m);

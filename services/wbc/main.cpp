@@ -16,6 +16,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
+#include "services/runtime/live_tuning.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
@@ -71,8 +72,10 @@ static int toolMain(int argc, char** argv) {
 
   wbc::WbcConfig config;
   model::MftPolytope polytope;
+  std::string config_text;  // the base of live changes (docs/live-tuning.md)
   try {
     config = wbc::loadWbcConfig(ctx.configFile("wbc.yaml"));
+    config_text = services::configTextInForce(ctx.configFile("wbc.yaml"));
     polytope = model::loadMftPolytope(ctx.configFile("mft_space.yaml"), ctx.robot());
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
@@ -109,6 +112,17 @@ static int toolMain(int argc, char** argv) {
   services::TopicWriter<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> diag_writer(
       ctx.participant(), "WbcDiagnostics", ctx.chainWriterProfile());
 
+  // Live tuning (mft-cmd --set wbc.<key>=<value>): judged here off the loop by wbc.yaml's strict loader, applied
+  // at the tick boundary in process().
+  using Tuning = services::LiveTuning<wbc::WbcTuning>;
+  Tuning tuning(ctx.participant(), "mft-wbc", msg::CONFIG_TARGET_WBC, msg::COMMAND_SOURCE_WBC, ctx.lockstep(),
+                services::tuningStatusFile(cli.get("summary")), config_text,
+                [&ctx](const std::string& text, const std::string& key, const std::string& value) {
+                  auto o = wbc::applyWbcOverride(text, "wbc.yaml (live change)", key, value, ctx.robot());
+                  return Tuning::Judged{wbc::tuningOf(o.config), std::move(o.yaml_text), std::move(o.value),
+                                        std::move(o.previous)};
+                });
+
   const std::uint64_t max_age = ctx.lockstep() ? 0 : static_cast<std::uint64_t>(cli.getInt("reference-max-age", 0, 50));
   // Only a repeated RobotState (a re-sent tick) gets the cached answer again, not the Reference of a tick
   // already answered: one command per tick keeps the lockstep chain's traffic minimal.
@@ -123,6 +137,8 @@ static int toolMain(int argc, char** argv) {
       return;
     }
     if (answered && state.tick < last_tick) return;
+    tuning.applyDue(state.tick, state.time_s, services::toStampNs(state.time_s),
+                    [&](const wbc::WbcTuning& t) { controller.setTuning(t); });
     hops.mark(2, state.tick);
     const model::ActuatorCommand command = controller.update(state, reference, &diag);
     diag.tick = state.tick;
@@ -199,7 +215,8 @@ static int toolMain(int argc, char** argv) {
                 static_cast<unsigned long long>(s.damping_ticks), static_cast<unsigned long long>(refused_inputs),
                 static_cast<unsigned long long>(gate.refused()), static_cast<unsigned long long>(gate.newClocks()),
                 static_cast<unsigned long long>(state_reader.requestedDeadlineMisses()));
-  ctx.writeSummary(std::string(buf) + "\"solve_time_us\": " + solve_us.json() + ", \"tick_time_us\": " + tick_us.json() + "}");
+  ctx.writeSummary(std::string(buf) + "\"solve_time_us\": " + solve_us.json() + ", \"tick_time_us\": " + tick_us.json() +
+                   ", \"live_changes\": " + tuning.summaryJson() + "}");
   return 0;
 }
 

@@ -3,7 +3,8 @@
 1 N s steps. Checks the table's shape (table.csv, table.md), that every cell's boundary is bracketed by a
 recovered and a failed run of results.jsonl one grid step apart, that the kept rawlogs exist and reproduced their
 runs; that an interrupted sweep (SIGINT) leaves no process behind and resumes to the same table without
-re-running a finished run; and clear one-line errors on bad arguments. DDS domains 94-97 (90-99: no other test; the integration tests take 100-219)."""
+re-running a finished run; and clear one-line errors on bad arguments. DDS domains 94-97 (90-99: besides only
+operator_commands 90-93 and live_tuning 98-99; the integration tests take 100-219)."""
 import csv
 import json
 import os

@@ -90,4 +90,18 @@ TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
   const auto back = roundTrip<mft::msg::CommandVerdict, mft::msg::CommandVerdictPubSubType>(verdict);
   EXPECT_TRUE(back == verdict);
   EXPECT_STREQ(back.reason().data(), reason);
+  mft::msg::ConfigChange change;  // live tuning (docs/live-tuning.md)
+  change.seq(42);
+  change.target(mft::msg::CONFIG_TARGET_PLANNER);
+  const char key[] = "foot_placement.k_v", value[] = "0.145";
+  std::copy(std::begin(key), std::end(key), change.key().begin());
+  std::copy(std::begin(value), std::end(value), change.value().begin());
+  change.at_s(12.5);
+  change.applied(true);
+  change.tick(12500);
+  change.number({0.145, 0.0});
+  change.count(1);
+  const auto change_back = roundTrip<mft::msg::ConfigChange, mft::msg::ConfigChangePubSubType>(change);
+  EXPECT_TRUE(change_back == change);
+  EXPECT_STREQ(change_back.key().data(), key);
 }

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <thread>
+#include <cstdio>
 #include <ctime>
 #include <sstream>
 
@@ -316,6 +317,38 @@ TEST(RawlogFormat, KnowsEveryFieldOfEveryTopic) {
   EXPECT_EQ(msg::WbcDiagnosticsPubSubType().m_typeSize, 152u) << "WbcDiagnostics changed: update rawlog_format.cpp";
   EXPECT_EQ(msg::OperatorCommandPubSubType().m_typeSize, 32u) << "OperatorCommand changed: update rawlog_format.cpp";
   EXPECT_EQ(msg::DisturbancePubSubType().m_typeSize, 40u) << "Disturbance changed: update rawlog_format.cpp";
+  EXPECT_EQ(msg::ConfigChangePubSubType().m_typeSize, 200u) << "ConfigChange changed: update rawlog_format.cpp";
+}
+
+// Live tuning (docs/live-tuning.md): an applied change goes through the config_change label and comes back with
+// its key (recorded as its index in tunableKeys()), value, tick and time; a key that is not tunable reads back
+// empty, so mft-replay cannot mistake it for another.
+TEST(RawlogFormat, ConfigChangeRoundTripsThroughItsLabel) {
+  msg::ConfigChange c;
+  c.seq(77), c.target(msg::CONFIG_TARGET_WBC), c.applied(true), c.at_s(12.0), c.tick(12000), c.stamp_ns(12000000000ULL);
+  std::snprintf(c.key().data(), c.key().size(), "gains.swing_foot.kp");
+  std::snprintf(c.value().data(), c.value().size(), "[300,250]");
+  c.number({300.0, 250.0}), c.count(2);
+  ObservationEncoder enc;
+  MessageAssembler asm_(0);
+  Message out;
+  std::int64_t t = 0;
+  bool done = false;
+  for (int li : enc.encode(c, 5)) done = asm_.add(enc.observation(li), &out, &t);
+  ASSERT_TRUE(done);
+  const auto& b = std::get<msg::ConfigChange>(out);
+  EXPECT_EQ(b.seq(), 77u);
+  EXPECT_TRUE(b.applied());
+  EXPECT_EQ(b.target(), msg::CONFIG_TARGET_WBC);
+  EXPECT_STREQ(b.key().data(), "gains.swing_foot.kp");
+  EXPECT_STREQ(b.value().data(), "[300, 250]");
+  EXPECT_EQ(b.tick(), 12000u);
+  EXPECT_EQ(b.at_s(), 12.0);
+  EXPECT_EQ(b.count(), 2);
+  std::snprintf(c.key().data(), c.key().size(), "variant");  // not tunable: index -1
+  for (int li : enc.encode(c, 6)) done = asm_.add(enc.observation(li), &out, &t);
+  ASSERT_TRUE(done);
+  EXPECT_STREQ(std::get<msg::ConfigChange>(out).key().data(), "");
 }
 
 // ------------------------------------------------------------------------------ bad input (issue 16, part 3)

@@ -1,5 +1,6 @@
 // update() allocates nothing once constructed (counted through the global operator new of this test binary),
-// and a sequence of varying ticks (stance changes, perturbations) solves every tick.
+// and a sequence of varying ticks (stance changes, perturbations) solves every tick. A live change of weights
+// and gains (setTuning, docs/live-tuning.md) halfway through allocates nothing either.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -48,12 +49,18 @@ TEST(WbcRealtime, VaryingSequenceSolvesEveryTickWithoutAllocating) {
       refs.push_back(test::holdReference(states.back(), phase != 2, phase != 1));
       refs.back().base_z.pos = 0.40;
     }
+    WbcTuning tuned = wbc.tuning();
+    tuned.weights.slack = 1e5;
+    tuned.weights.contact_force = 1e-4;
+    tuned.gains.base_z.kp = 200.0;
+    tuned.gains.swing_foot.kp = {300.0, 300.0};
     WbcDiagnostics diag;
     wbc.update(states[0], refs[0], &diag);  // warm-up tick outside the count
     g_allocations = 0;
     g_counting = true;
     int failures = 0;
     for (std::size_t k = 0; k < states.size(); ++k) {
+      if (k == states.size() / 2) wbc.setTuning(tuned);
       const model::ActuatorCommand c = wbc.update(states[k], refs[k], &diag);
       failures += diag.status != qp::QpStatus::Optimal || c.mode != model::CommandMode::Normal;
     }

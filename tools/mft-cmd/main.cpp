@@ -64,16 +64,215 @@ struct Verdict {
 
 }  // namespace
 
+// --set: one ConfigChange per FILE.KEY=VALUE, written in order (each acknowledged before the next: the command
+// writer keeps one sample), then every verdict awaited. Exit status: the worst of the changes.
+static int runSet(const services::CommandLine& cli) {
+  struct Change {
+    std::string file, key, value, answerer;
+    std::uint8_t source = 0;
+    msg::ConfigChange msg;
+    std::vector<Verdict> verdicts;
+    std::string result = "no_verdict";
+    int code = kNoVerdict;
+  };
+  const int domain = static_cast<int>(cli.getInt("domain", 0, services::kMaxDomainId));
+  const auto base_seq = cli.isSet("seq")
+                            ? static_cast<std::uint64_t>(cli.getInt("seq", 0, 1L << 62))
+                            : (static_cast<std::uint64_t>(std::chrono::system_clock::now().time_since_epoch() /
+                                                          std::chrono::milliseconds(1))
+                               << 16) | ((static_cast<std::uint64_t>(getpid()) & 0xfffu) << 4);
+  const double at_s = cli.getDouble("at", 0.0, 1e6);
+  const double timeout_s = cli.getDouble("timeout", 0.1, 600);
+  const double verdict_timeout_s = cli.getDouble("verdict-timeout", 0.1, 3600);
+  const auto timeout = std::chrono::milliseconds(static_cast<long>(timeout_s * 1000));
+  const bool json = cli.isSet("json");
+  const bool accepted_only = cli.isSet("accepted-only");
+
+  std::vector<Change> changes;
+  for (const std::string& item : cli.getAll("set")) {
+    const auto eq = item.find('='), dot = item.find('.');
+    if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq)
+      cli.fail("--set '" + item + "': expected FILE.KEY=VALUE, e.g. wbc.weights.slack=1e5");
+    Change c;
+    c.file = item.substr(0, dot);
+    c.key = item.substr(dot + 1, eq - dot - 1);
+    c.value = item.substr(eq + 1);
+    if (c.file == "wbc") {
+      c.answerer = "mft-wbc";
+      c.source = msg::COMMAND_SOURCE_WBC;
+      c.msg.target(msg::CONFIG_TARGET_WBC);
+    } else if (c.file == "planner") {
+      c.answerer = "mft-planner";
+      c.source = msg::COMMAND_SOURCE_PLANNER;
+      c.msg.target(msg::CONFIG_TARGET_PLANNER);
+    } else {
+      cli.fail("--set '" + item + "': '" + c.file + "' is not a live-tunable file (wbc or planner)");
+    }
+    if (c.value.empty()) cli.fail("--set '" + item + "': no value after '='");
+    if (c.key.size() >= c.msg.key().size() || c.value.size() >= c.msg.value().size())
+      cli.fail("--set '" + item + "': key and value must be shorter than 64 characters each");
+    if (changes.size() >= 16) cli.fail("--set: at most 16 changes at once");
+    c.msg.seq(base_seq + changes.size());
+    std::snprintf(c.msg.key().data(), c.msg.key().size(), "%s", c.key.c_str());
+    std::snprintf(c.msg.value().data(), c.msg.value().size(), "%s", c.value.c_str());
+    c.msg.at_s(at_s);
+    c.msg.applied(false);
+    changes.push_back(c);
+  }
+
+  int matched = 0;
+  bool acknowledged = false;
+  auto finish = [&](int code, const std::string& result, const std::string& error) {
+    if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
+    if (json) {
+      std::string list = "[";
+      for (const auto& c : changes) {
+        std::string v = "[";
+        for (const auto& x : c.verdicts)
+          v += std::string(v.size() > 1 ? ", " : "") + "{\"verdict\": \"" + services::verdictName(x.verdict) +
+               "\", \"tick\": " + std::to_string(x.tick) + ", \"time_s\": " +
+               fmt(static_cast<double>(x.stamp_ns) * 1e-9, 4) + ", \"reason\": " + jsonString(x.reason) +
+               ", \"after_s\": " + fmt(x.waited_s, 3) + "}";
+        list += std::string(list.size() > 1 ? ", " : "") + "{\"file\": " + jsonString(c.file) + ", \"key\": " +
+                jsonString(c.key) + ", \"value\": " + jsonString(c.value) + ", \"seq\": " + std::to_string(c.msg.seq()) +
+                ", \"answered_by\": \"" + c.answerer + "\", \"verdicts\": " + v + "], \"result\": \"" + c.result + "\"}";
+      }
+      std::printf("{\"command\": \"ConfigChange\", \"domain\": %d, \"at_s\": %s, \"readers_matched\": %d, "
+                  "\"acknowledged\": %s, \"changes\": %s], \"result\": \"%s\", \"exit_code\": %d, \"error\": %s}\n",
+                  domain, fmt(at_s, -6).c_str(), matched, acknowledged ? "true" : "false", list.c_str(), result.c_str(),
+                  code, jsonString(error).c_str());
+    }
+    std::fflush(stdout);
+    return code;
+  };
+
+  try {
+    services::DdsParticipant participant(domain, cli.get("profiles"), "mft-cmd",
+                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")});
+    std::mutex mutex;
+    std::vector<std::vector<Verdict>> received(changes.size());
+    std::vector<Clock::time_point> written_at(changes.size(), Clock::now());
+    services::TopicReader<msg::CommandVerdict, msg::CommandVerdictPubSubType> verdict_reader(
+        participant, "CommandVerdict", "event_reader", [&](const msg::CommandVerdict& m) {
+          if (m.seq() < base_seq || m.seq() >= base_seq + changes.size()) return;
+          const std::size_t i = static_cast<std::size_t>(m.seq() - base_seq);
+          if (m.source() != changes[i].source) return;
+          std::lock_guard<std::mutex> lock(mutex);
+          Verdict v;
+          v.verdict = m.verdict();
+          v.tick = m.tick();
+          v.stamp_ns = m.stamp_ns();
+          v.reason.assign(m.reason().data(), strnlen(m.reason().data(), m.reason().size()));
+          v.waited_s = std::chrono::duration<double>(Clock::now() - written_at[i]).count();
+          received[i].push_back(v);
+        });
+    // One writer per change: the command writer keeps one sample (KEEP_LAST 1, transient local), so a reader that
+    // matches only after the writes (discovery reports the WBC's and the planner's readers one at a time) still
+    // gets every change, not only the last one.
+    using Writer = services::TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>;
+    std::vector<std::unique_ptr<Writer>> writers;
+    for (std::size_t i = 0; i < changes.size(); ++i)
+      writers.push_back(std::make_unique<Writer>(participant, "ConfigChange", "command_writer"));
+    const auto all_matched = [&] {
+      for (const auto& w : writers)
+        if (w->matched() == 0) return false;
+      return true;
+    };
+    if (!services::waitUntil(all_matched, timeout))
+      return finish(kNoStack, "no_stack",
+                    "no stack answered on domain " + std::to_string(domain) + " within " + fmt(timeout_s, -6) +
+                        " s (no reader of ConfigChange; is the stack up on this domain?)");
+    acknowledged = true;  // every write's acknowledgement, below
+    for (std::size_t i = 0; i < changes.size(); ++i) {
+      written_at[i] = Clock::now();
+      if (!writers[i]->write(changes[i].msg)) return finish(kUsage, "error", "the DDS writer refused the ConfigChange");
+    }
+    for (const auto& w : writers) acknowledged = w->waitForAcknowledgments(timeout) && acknowledged;
+    matched = writers.front()->matched();
+    if (!json) {
+      std::printf("mft-cmd: %zu ConfigChange(s) (%s) written to %d reader(s) on domain %d, %s\n", changes.size(),
+                  at_s > 0 ? ("at t = " + fmt(at_s, 3) + " s").c_str() : "at the next tick", matched, domain,
+                  acknowledged ? "acknowledged" : "NOT acknowledged yet");
+      std::fflush(stdout);
+    }
+    const auto deadline = written_at.back() + std::chrono::duration<double>(verdict_timeout_s);
+    std::vector<std::size_t> shown(changes.size(), 0);
+    for (;;) {
+      bool open = false;
+      for (std::size_t i = 0; i < changes.size(); ++i) {
+        Change& c = changes[i];
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          c.verdicts = received[i];
+        }
+        for (; shown[i] < c.verdicts.size(); ++shown[i]) {
+          const auto& v = c.verdicts[shown[i]];
+          if (v.verdict == msg::VERDICT_REJECTED) {
+            c.result = "rejected";
+            c.code = kRejected;
+            std::fprintf(stderr, "mft-cmd: %s rejected %s.%s=%s (seq %llu): %s\n", c.answerer.c_str(), c.file.c_str(),
+                         c.key.c_str(), c.value.c_str(), static_cast<unsigned long long>(c.msg.seq()), v.reason.c_str());
+          } else {
+            if (!json)
+              std::printf("%s: %s.%s %s at tick %llu: %s\n", c.answerer.c_str(), c.file.c_str(), c.key.c_str(),
+                          services::verdictName(v.verdict), static_cast<unsigned long long>(v.tick), v.reason.c_str());
+            c.result = v.verdict == msg::VERDICT_APPLIED ? "applied" : "scheduled";
+            c.code = kAccepted;
+          }
+        }
+        const bool settled = c.result == "applied" || c.result == "rejected" || (accepted_only && c.result == "scheduled");
+        open = open || !settled;
+      }
+      std::fflush(stdout);
+      if (!open || Clock::now() > deadline) break;
+      if (!acknowledged && Clock::now() > written_at.back() + timeout) {
+        bool any = false;
+        for (const auto& c : changes) any = any || !c.verdicts.empty();
+        if (!any)
+          return finish(kNotAcknowledged, "not_acknowledged",
+                        "the " + std::to_string(matched) + " reader(s) of ConfigChange on domain " +
+                            std::to_string(domain) + " did not acknowledge within " + fmt(timeout_s, -6) + " s");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    int code = kAccepted;
+    std::string error;
+    for (const auto& c : changes) {
+      if (c.code == kNoVerdict)
+        error += std::string(error.empty() ? "" : "; ") + "no verdict from " + c.answerer + " on " + c.file + "." + c.key +
+                 " (seq " + std::to_string(c.msg.seq()) + ") within " + fmt(verdict_timeout_s, -6) + " s (is " +
+                 c.answerer + " running?)";
+      if (c.code == kRejected && code != kNoVerdict) code = kRejected;
+      if (c.code == kNoVerdict) code = kNoVerdict;
+      if (!json && c.result == "scheduled" && !accepted_only)
+        std::printf("mft-cmd: %s.%s accepted by %s, not applied within %g s (it stays scheduled)\n", c.file.c_str(),
+                    c.key.c_str(), c.answerer.c_str(), verdict_timeout_s);
+    }
+    std::string result = "applied";
+    for (const auto& c : changes)
+      if (c.result != "applied") result = c.result == "scheduled" && result == "applied" ? "scheduled" : result;
+    if (code == kRejected) result = "rejected";
+    if (code == kNoVerdict) result = "no_verdict";
+    return finish(code, result, error);
+  } catch (const services::DdsError& e) {
+    return finish(kUsage, "error", e.what());
+  }
+}
+
 static int toolMain(int argc, char** argv) {
   services::CommandLine cli(
       "mft-cmd",
       "Send an operator command or a push to a running mft-wbc stack and wait for its verdict.\n"
       "  mft-cmd --domain 0 --mode step_in_place --height 0.42 --speed 0.0\n"
       "  mft-cmd --domain 0 --push 3.0 [--at 4.5 | --at-liftoff right]\n"
+      "  mft-cmd --domain 0 --set wbc.weights.slack=1e5 --set wbc.gains.base_z.kp=300 [--at 20.0]\n"
       "The planner answers commands, the simulator pushes: rejected (with the reason), scheduled (a push at a\n"
       "lift-off or a later time) or applied at a tick. mft-cmd waits for 'applied' (or a rejection) up to\n"
       "--verdict-timeout; a command still only scheduled then counts as accepted. Protocol:\n"
-      "docs/operator-commands.md.\n"
+      "docs/operator-commands.md. --set changes a tunable key of config/wbc.yaml (answered by mft-wbc) or\n"
+      "config/planner.yaml (mft-planner) while the stack runs, judged by that file's strict loader; a lockstep stack\n"
+      "takes it at a stated simulated time only (--at), a realtime one at the next tick without --at\n"
+      "(docs/live-tuning.md). Several --set: one change each, in order; the exit status is the worst.\n"
       "Exit status: 0 accepted (applied, or scheduled by the stack); 1 rejected by the stack (the reason is\n"
       "printed); 2 usage, input or DDS set-up error; 3 no stack answered on the domain within --timeout (no\n"
       "reader matched); 4 the readers did not acknowledge the command within --timeout; 5 no verdict within\n"
@@ -83,8 +282,10 @@ static int toolMain(int argc, char** argv) {
   cli.option("height", "base height command [m] (the planner accepts its reachable range)", "0.42");
   cli.option("speed", "average sagittal speed command [m/s]", "0.0");
   cli.option("push", "sagittal impulse on the torso [N s], + forward (a disturbance)");
-  cli.option("at", "apply the push at this simulated time [s] (0: now)", "0");
+  cli.option("at", "apply the push, or the --set changes, at this simulated time [s] (0: now / the next tick)", "0");
   cli.option("at-liftoff", "apply the push at the next lift-off of this leg: right | left");
+  cli.option("set", "FILE.KEY=VALUE: change a tunable key of config/FILE.yaml (wbc or planner) while the stack runs, "
+             "e.g. wbc.weights.slack=1e5 or wbc.gains.swing_foot.kp=[300,300] (repeatable)");
   cli.option("seq", "sequence number of the command, echoed by its verdict (default: from the clock and pid)");
   cli.option("timeout", "seconds to wait for a reader of the stack to match, and again for the acknowledgement", "5");
   cli.option("verdict-timeout", "seconds to wait for the stack's verdict once the command is written", "10");
@@ -97,7 +298,12 @@ static int toolMain(int argc, char** argv) {
   cli.parse(argc, argv);
 
   const bool has_cmd = cli.isSet("mode"), has_push = cli.isSet("push");
-  if (has_cmd == has_push) cli.fail("give either --mode (an operator command) or --push (a disturbance)");
+  if (cli.isSet("set")) {
+    if (has_cmd || has_push || cli.isSet("at-liftoff"))
+      cli.fail("--set goes alone (with --at), not with --mode, --push or --at-liftoff");
+    return runSet(cli);
+  }
+  if (has_cmd == has_push) cli.fail("give either --mode (an operator command), --push (a disturbance) or --set (a live change)");
   if (has_cmd && (cli.isSet("at") || cli.isSet("at-liftoff"))) cli.fail("--at and --at-liftoff go with --push");
   if (has_push && (cli.isSet("height") || cli.isSet("speed"))) cli.fail("--height and --speed go with --mode");
   if (cli.isSet("at") && cli.isSet("at-liftoff")) cli.fail("give --at or --at-liftoff, not both");

@@ -6,7 +6,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <deque>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <optional>
@@ -47,6 +49,48 @@ std::string takeFile(int* argc, char** argv) {
 using config::jsonEscape;
 
 // ------------------------------------------------------------------------------------------ --through-wbc
+// The WBC changes applied while the run was recorded (live tuning, docs/live-tuning.md): a first pass over the
+// file collects the applied ConfigChange records of mft-wbc (written some ticks after the tick they act from), and
+// each becomes the controller's weights and gains from its tick on, judged by the same strict loader as live.
+struct RecordedChange {
+  std::uint64_t seq = 0, tick = 0;
+  std::string key, value;
+  wbc::WbcTuning tuning;
+};
+std::vector<RecordedChange> recordedWbcChanges(const std::string& path, const std::string& base_text,
+                                               const model::RobotDescription& robot) {
+  rawlog::RawlogReader reader(path);
+  rawlog::MessageAssembler assembler(reader.metadata().time_base_unix_ns);
+  mrpt::obs::CObservation::Ptr obs;
+  rawlog::Message m;
+  std::int64_t unix_ns = 0;
+  std::vector<RecordedChange> out;
+  while (reader.next(&obs)) {
+    if (!assembler.add(*obs, &m, &unix_ns) || rawlog::topicOf(m) != rawlog::Topic::ConfigChange) continue;
+    const auto& c = std::get<msg::ConfigChange>(m);
+    if (!c.applied() || c.target() != msg::CONFIG_TARGET_WBC) continue;
+    RecordedChange r;
+    r.seq = c.seq();
+    r.tick = c.tick();
+    r.key.assign(c.key().data(), strnlen(c.key().data(), c.key().size()));
+    r.value.assign(c.value().data(), strnlen(c.value().data(), c.value().size()));
+    if (r.key.empty() || r.value.empty())
+      throw std::runtime_error("a recorded live change (seq " + std::to_string(r.seq) + ") names no tunable key or value");
+    out.push_back(r);
+  }
+  // In the order they took effect (seq breaks a tie: the order mft-wbc applied them in).
+  std::stable_sort(out.begin(), out.end(), [](const RecordedChange& a, const RecordedChange& b) {
+    return a.tick != b.tick ? a.tick < b.tick : a.seq < b.seq;
+  });
+  std::string text = base_text;
+  for (auto& r : out) {
+    auto o = wbc::applyWbcOverride(text, "recorded wbc.yaml (live change)", r.key, r.value, robot);
+    r.tuning = wbc::tuningOf(o.config);
+    text = o.yaml_text;
+  }
+  return out;
+}
+
 int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
   const auto& md = reader.metadata();
   const bool json = cli.isSet("json");
@@ -62,6 +106,7 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
   std::unique_ptr<wbc::WholeBodyController> controller;
   model::RobotDescription robot;
   model::MftPolytope polytope;
+  std::vector<RecordedChange> changes;
   try {
     robot = model::parseRobotDescription(need("robot.yaml"), "recorded robot.yaml");
     if (!md.robot_checksum.empty() && model::checksumHex(robot.checksum) != md.robot_checksum)
@@ -73,6 +118,18 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
     if (!wbc::parseVariant(md.controller, &config.variant))
       throw std::runtime_error("unknown recorded controller '" + md.controller + "'");
     controller = std::make_unique<wbc::WholeBodyController>(robot, config, &polytope);
+    if (!cli.isSet("ignore-live-changes")) {
+      std::string base_text;
+      if (cli.isSet("wbc-config")) {
+        std::ifstream in(cli.get("wbc-config"));
+        std::stringstream ss;
+        ss << in.rdbuf();
+        base_text = ss.str();
+      } else {
+        base_text = need("wbc.yaml");
+      }
+      changes = recordedWbcChanges(reader.path(), base_text, robot);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mft-replay: cannot rebuild the controller from the recording: %s\n", e.what());
     return kExitBadInput;
@@ -102,7 +159,11 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
   long long first_diff_tick = -1;
   double max_diff = 0.0, first_diff_value = 0.0;
   long long max_diff_tick = -1;
+  std::size_t next_change = 0;
   auto compare = [&](const model::RobotStateEstimate& state, const wbc::WbcReference& ref, const msg::JointCommand& rec) {
+    // The recorded live changes due at this tick, at the tick boundary as in mft-wbc.
+    for (; next_change < changes.size() && changes[next_change].tick <= rec.tick(); ++next_change)
+      controller->setTuning(changes[next_change].tuning);
     wbc::WbcDiagnostics diag;
     const model::ActuatorCommand cmd = controller->update(state, ref, &diag);
     double d = 0.0;
@@ -173,17 +234,20 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
     std::printf("{\"mode\": \"through-wbc\", \"file\": \"%s\", \"ticks_compared\": %llu, \"unmatched_commands\": %llu, "
                 "\"max_abs_diff_Nm\": %.17g, \"max_diff_tick\": %lld, \"tolerance\": %.17g, \"differing_ticks\": %llu, "
                 "\"first_differing_tick\": %lld, \"first_difference_Nm\": %.17g, \"mode_mismatches\": %llu, "
-                "\"end\": \"%s\", \"end_message\": \"%s\", \"ok\": %s}\n",
+                "\"live_changes\": %zu, \"live_changes_applied\": %zu, \"end\": \"%s\", \"end_message\": \"%s\", \"ok\": %s}\n",
                 jsonEscape(reader.path()).c_str(), static_cast<unsigned long long>(compared),
                 static_cast<unsigned long long>(unmatched), max_diff, max_diff_tick, tolerance,
                 static_cast<unsigned long long>(differing), first_diff_tick, first_diff_value,
-                static_cast<unsigned long long>(mode_mismatches), rawlog::toString(reader.end()),
+                static_cast<unsigned long long>(mode_mismatches), changes.size(), next_change, rawlog::toString(reader.end()),
                 jsonEscape(reader.endMessage()).c_str(), ok ? "true" : "false");
   } else {
     std::printf("through-wbc  %s (%s, controller %s)\n", reader.path().c_str(), md.mode.c_str(), md.controller.c_str());
     std::printf("compared     %llu ticks (%llu commands without their state/reference)\n",
                 static_cast<unsigned long long>(compared), static_cast<unsigned long long>(unmatched));
     std::printf("max |dtau|   %.3g N m (tick %lld), tolerance %.3g N m\n", max_diff, max_diff_tick, tolerance);
+    for (const auto& c : changes)
+      std::printf("live change  wbc.%s = %s from tick %llu\n", c.key.c_str(), c.value.c_str(),
+                  static_cast<unsigned long long>(c.tick));
     if (differing) std::printf("DIFFERENT    %llu ticks, first at tick %lld (%.3g N m)\n",
                                static_cast<unsigned long long>(differing), first_diff_tick, first_diff_value);
     else std::printf("identical    within the tolerance\n");
@@ -218,6 +282,7 @@ class Publisher {
     if (want(Topic::WbcDiagnostics)) wd_ = std::make_unique<decltype(wd_)::element_type>(p, "WbcDiagnostics", chain_profile);
     if (want(Topic::OperatorCommand)) oc_ = std::make_unique<decltype(oc_)::element_type>(p, "OperatorCommand", "event_writer");
     if (want(Topic::Disturbance)) db_ = std::make_unique<decltype(db_)::element_type>(p, "Disturbance", "event_writer");
+    if (want(Topic::ConfigChange)) cc_ = std::make_unique<decltype(cc_)::element_type>(p, "ConfigChange", "event_writer");
   }
   void publish(const rawlog::Message& m) {
     std::visit(
@@ -230,6 +295,7 @@ class Publisher {
           else if constexpr (std::is_same_v<T, msg::JointCommand>) jc_->write(x);
           else if constexpr (std::is_same_v<T, msg::WbcDiagnostics>) wd_->write(x);
           else if constexpr (std::is_same_v<T, msg::OperatorCommand>) oc_->write(x);
+          else if constexpr (std::is_same_v<T, msg::ConfigChange>) cc_->write(x);
           else db_->write(x);
         },
         m);
@@ -251,6 +317,7 @@ class Publisher {
   std::unique_ptr<services::TopicWriter<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType>> wd_;
   std::unique_ptr<services::TopicWriter<msg::OperatorCommand, msg::OperatorCommandPubSubType>> oc_;
   std::unique_ptr<services::TopicWriter<msg::Disturbance, msg::DisturbancePubSubType>> db_;
+  std::unique_ptr<services::TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>> cc_;
 };
 
 // A read-ahead thread keeps file I/O and decoding off the pacing thread (docs/mrpt.md#write-stalls-and-flushing: I/O hiccups).
@@ -340,6 +407,8 @@ static int toolMain(int argc, char** argv) {
   cli.flag("through-wbc", "regression check: recorded RobotState + Reference -> fresh WBC -> compare with JointCommand");
   cli.option("tolerance", "--through-wbc: largest accepted |tau - tau_recorded| [N m]", "1e-9");
   cli.option("wbc-config", "--through-wbc: use this wbc.yaml instead of the recorded one (to test a change)");
+  cli.flag("ignore-live-changes", "--through-wbc: do not apply the WBC changes recorded from mft-cmd --set "
+           "(docs/live-tuning.md); by default each acts from its recorded tick");
   cli.flag("json", "print the result as JSON");
   cli.parse(argc, argv);
   if (file.empty()) file = cli.get("file");

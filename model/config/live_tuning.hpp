@@ -1,0 +1,36 @@
+#pragma once
+// Live tuning (docs/live-tuning.md): the configuration keys a running stack may change (`mft-cmd --set`), and
+// the one way a change is judged: the key is set in a copy of the file's YAML and the copy goes through the
+// file's own strict loader, so a refused change carries the loader's message.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace mft::config {
+
+// A key that may change while the controller runs: gains and weights, never structure (variant, horizon,
+// limits, gait timing). `size` is the number of values (1 or 2: [x, z]).
+struct TunableKey {
+  const char* stem;  // the configuration file: "wbc" (config/wbc.yaml) or "planner"
+  const char* key;   // dotted path inside it
+  int size;
+};
+// The list, in a fixed order: a recording names a key by its index here (rawlog label config_change), so
+// entries are only ever appended.
+const std::vector<TunableKey>& tunableKeys();
+// Index in tunableKeys(), or -1 if the key is not tunable.
+int tunableIndex(const std::string& stem, const std::string& key);
+// "weights.*, gains.*" style summary of the tunable keys of one file, for messages.
+std::string describeTunable(const std::string& stem);
+
+// `yaml_text` with the value at `dotted_key` replaced by (or, if absent, set to) the YAML value `value_yaml`
+// ("1e3", "[300, 300]"). A key the file does not have is added, so the strict loader that reads the result
+// names it as unknown. Throws ConfigError only for what is not YAML at all or a path through a plain value.
+std::string setKey(const std::string& yaml_text, const std::string& dotted_key, const std::string& value_yaml,
+                   const std::string& origin);
+// The numbers at `dotted_key` of `yaml_text` (a number or a list of numbers); empty if there are none.
+std::vector<double> numbersAt(const std::string& yaml_text, const std::string& dotted_key);
+// "1000" or "[300, 300]" (shortest text that reads back to the same doubles).
+std::string formatNumbers(const double* values, std::size_t count);
+
+}  // namespace mft::config

@@ -1,0 +1,58 @@
+#include "services/runtime/live_tuning.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "model/config/profiles.hpp"
+#include "model/config/strict_yaml.hpp"
+
+namespace mft::services {
+
+std::string tuningStatusFile(const std::string& summary_file) {
+  const std::string suffix = ".summary.json";
+  if (summary_file.size() <= suffix.size() ||
+      summary_file.compare(summary_file.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return summary_file.empty() ? "" : summary_file + ".tuning.json";
+  return summary_file.substr(0, summary_file.size() - suffix.size()) + ".tuning.json";
+}
+
+bool writeTuningStatus(const std::string& path, const std::string& json) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp);
+    if (!(out << json << "\n")) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
+
+std::string jsonEscape(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string configTextInForce(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  if (!in || !(text << in.rdbuf())) throw config::ConfigError(path + ": cannot read the file");
+  const auto& profiles = config::activeProfiles();
+  const std::string stem = config::profileStemOf(path);
+  if (!stem.empty() && profiles.touches(stem)) return profiles.applyToText(stem, text.str(), path);
+  return text.str();
+}
+
+}  // namespace mft::services

@@ -36,7 +36,7 @@
 #include "services/record/recorder.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/topic_names.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 #include "services/runtime/service_context.hpp"
 #include "model/config/tool_io.hpp"
 
@@ -301,10 +301,10 @@ static int toolMain(int argc, char** argv) {
   const std::string config_dir = cli.get("config-dir");
   auto config_file = [&](const std::string& name) { return config_dir + "/" + name; };
   model::RobotDescription robot;
-  services::Scenario scenario;
+  chain::Scenario scenario;
   try {
-    scenario = services::loadScenario(cli.get("scenario"));
-    scenario.profiles = services::activateRunProfiles(config_dir, scenario, cli.getAll("profile"));
+    scenario = chain::loadScenario(cli.get("scenario"));
+    scenario.profiles = chain::activateRunProfiles(config_dir, scenario, cli.getAll("profile"));
     robot = model::loadRobotDescription(config_file("robot.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());

@@ -1,0 +1,34 @@
+#pragma once
+// The estimator stage of the chain: sensors(k) [+ truth(k)] -> estimate(k). The filter starts from the
+// simulator's pose at the first tick (the robot is placed at a known standing pose), so that tick needs the
+// truth; in the scenario's ground_truth mode every tick passes the simulator's truth through (to tell
+// controller problems from estimator problems).
+#include <string>
+
+#include "estimator/state_estimator.hpp"
+
+namespace mft::chain {
+
+// The estimator configuration with the scenario's `estimator` key ("kalman" | "ground_truth") applied.
+estimator::EstimatorConfig withScenarioMode(estimator::EstimatorConfig config, const std::string& scenario_estimator);
+
+class EstimatorNode {
+ public:
+  EstimatorNode(const estimator::EstimatorConfig& config, const model::RobotDescription& robot)
+      : mode_(config.mode), estimator_(config, robot) {}
+
+  // Whether the next update needs the truth of the same tick.
+  bool needsTruth() const { return !initialized_ || mode_ == estimator::EstimatorMode::GroundTruth; }
+  // `truth` must be the same tick's when needsTruth(); otherwise it is not used (may be null).
+  const model::RobotStateEstimate& update(const model::SensorReadings& sensors, const model::GroundTruthState* truth);
+  // A new clock (a restarted simulator): the next update starts the filter again from the truth.
+  void restart() { initialized_ = false; }
+  const estimator::StateEstimator& estimator() const { return estimator_; }
+
+ private:
+  estimator::EstimatorMode mode_;
+  estimator::StateEstimator estimator_;
+  bool initialized_ = false;
+};
+
+}  // namespace mft::chain

@@ -12,7 +12,7 @@
 namespace mft::chain {
 
 // The project's one locomotion mode is the planner's (planner/plan_output.hpp); the IDL's LOCOMOTION_* octets
-// are converted at the DDS edge (services/runtime/convert.hpp).
+// are converted at the DDS edge (mft-planner, the one reader of OperatorCommand).
 using planner::LocomotionMode;
 
 struct ScenarioCommand {

@@ -210,6 +210,24 @@ std::string ClosedLoop::csvHeader() {
          "sea0,sea1,sea2,sea3,motor_tau0,motor_tau1,motor_tau2,motor_tau3,motor_w0,motor_w1,motor_w2,motor_w3";
 }
 
+std::string ClosedLoop::trajectoryHeader() {
+  return "tick,x,z,pitch,q4,q5,q6,q7,q8,q9,q10,q11,tau_q4,tau_q6,tau_q8,tau_q10";
+}
+
+std::string ClosedLoop::trajectoryRow() const {
+  std::string row = std::to_string(truth_at_estimate_.tick);
+  char v[32];
+  for (int i = 0; i < model::kNq; ++i) {
+    std::snprintf(v, sizeof v, ",%.17g", truth_at_estimate_.q[i]);
+    row += v;
+  }
+  for (int i = 0; i < model::kNa; ++i) {
+    std::snprintf(v, sizeof v, ",%.17g", wbc_->command().tau[i]);
+    row += v;
+  }
+  return row;
+}
+
 std::string ClosedLoop::csvRow() const {
   const auto& tr = truth_at_estimate_;
   const auto& e = estimate_;

@@ -119,6 +119,11 @@ class ClosedLoop {
   // CSV trace: header() once, then row() per tick (truth, estimate, reference, plan, WBC).
   static std::string csvHeader();
   std::string csvRow() const;
+  // The lockstep trajectory at full precision (%.17g), per tick k: the truth of tick k (what mft-sim publishes
+  // as GroundTruth(k)) and command(k): tick,x,z,pitch,q4..q11,tau_q4,tau_q6,tau_q8,tau_q10. Compared with a DDS
+  // stack's recording of the same scenario (tests/closedloop/test_inprocess_vs_dds.py).
+  static std::string trajectoryHeader();
+  std::string trajectoryRow() const;
 
  private:
   void accumulate();

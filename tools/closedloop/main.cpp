@@ -47,6 +47,7 @@ static int toolMain(int argc, char** argv) {
   cli.flag("continue-after-fall", "keep running after a fall");
   cli.option("csv", "write a per-tick trace to this CSV file");
   cli.option("csv-every", "write every n-th tick to the CSV", "1");
+  cli.option("trajectory", "write the full-precision trajectory (truth of tick k, command k) to this CSV file");
   cli.flag("json", "print the summary as JSON (default: a short text summary)");
   cli.option("dump-qp", "write the WBC's QP of the ticks in the dump window to this existing folder as WBCQP files "
              "(docs/qp-instances.md)");
@@ -130,6 +131,12 @@ static int toolMain(int argc, char** argv) {
     if (!csv) cli.fail("cannot write " + cli.get("csv"));
     csv << closedloop::ClosedLoop::csvHeader() << "\n";
   }
+  std::ofstream trajectory;
+  if (cli.isSet("trajectory")) {
+    trajectory.open(cli.get("trajectory"));
+    if (!trajectory) cli.fail("cannot write " + cli.get("trajectory"));
+    trajectory << closedloop::ClosedLoop::trajectoryHeader() << "\n";
+  }
   // QP dump window in ticks; writing files is fine here: this loop runs on the sim clock, not in real time.
   const bool dump = cli.isSet("dump-qp");
   const std::string dump_dir = cli.get("dump-qp"), dump_name = cli.get("dump-name");
@@ -146,6 +153,7 @@ static int toolMain(int argc, char** argv) {
   long n = 0;
   const auto& s = loop->run([&](const closedloop::ClosedLoop& l) {
     if (csv.is_open() && n++ % every == 0) csv << l.csvRow() << "\n";
+    if (trajectory.is_open()) trajectory << l.trajectoryRow() << "\n";
     const wbc::WholeBodyController& c = l.controller();
     if (!dump || !dump_error.empty() || !c.hasLastProblem()) return;
     const std::uint64_t tick = c.lastProblemTick();

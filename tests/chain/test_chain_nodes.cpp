@@ -2,6 +2,8 @@
 // playing a scenario push (at a time) and reporting it to the recovery window and to the caller.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "chain/command_schedule.hpp"
@@ -87,4 +89,24 @@ TEST(SimNode, PlaysAScenarioPushAtItsTimeAndReportsIt) {
   EXPECT_EQ(record.impulses, 1);
   EXPECT_DOUBLE_EQ(record.push_impulse_Ns, 2.0);
   EXPECT_FALSE(node.monitor().fell());
+}
+
+// The layer rule (docs/architecture.md): the chain library includes no transport, no recording and nothing of
+// services/, so a robot's bridge or the in-process loop can use it without them.
+TEST(ChainLibrary, IncludesNoTransportNoRecordingNoServices) {
+  const std::filesystem::path dir = std::filesystem::path(MFT_CONFIG_DIR).parent_path() / "chain";
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const auto ext = entry.path().extension();
+    if (ext != ".hpp" && ext != ".cpp") continue;
+    ++files;
+    std::ifstream in(entry.path());
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.rfind("#include", 0) != 0) continue;
+      for (const char* banned : {"fastdds", "fastrtps", "mrpt", "idl/", "services/", "tools/"})
+        EXPECT_EQ(line.find(banned), std::string::npos) << entry.path().filename() << ": " << line;
+    }
+  }
+  EXPECT_GE(files, 20);
 }

@@ -11,14 +11,14 @@
 
 #include "model/config/strict_yaml.hpp"
 #include "chain/scenario_limits.hpp"
-#include "services/runtime/process.hpp"
+#include "model/config/command_line.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 #include "model/config/tool_io.hpp"
 
 using namespace mft;
 
 static int toolMain(int argc, char** argv) {
-  services::CommandLine cli(
+  config::CommandLine cli(
       "mft-closedloop",
       "Run sim -> estimator -> planner -> WBC in one process on the sim clock, with the stack's configs, reference\n"
       "mapping and fall criteria. Without --scenario: stand at --height until --step-at, then step in place\n"

@@ -5,7 +5,7 @@
   mft-closedloop --config-dir <copy with actuators.model = M> --height H --controller C --duration 10
                  --push I --push-at 5 --recovery-rule R --json
 
-and takes the loop's own recovery verdict (services/runtime/push_recovery.hpp, the criterion every tool uses;
+and takes the loop's own recovery verdict (chain/push_recovery.hpp, the criterion every tool uses;
 --rule stepping = back to stepping in place, the default, or no_fall) at every coarse step from --start to --max, and in fine steps between every two
 neighbouring coarse points that disagree, so a non-monotonic boundary shows. I_max is the largest recovered push
 below the first failure; the largest recovered push and the recovered ranges are reported too. At most --jobs runs

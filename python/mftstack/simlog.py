@@ -1,7 +1,7 @@
 """Waiting on a running realtime stack through its simulator's log (run folder/mft-sim.log), for the
 multi-process tests: each wait is for the condition a test needs, bounded, and fails with what it saw.
 
-mft-sim prints (services/sim/main.cpp):
+mft-sim prints (services/sim/):
   "mft-sim: the chain answered tick 0: the clock starts"
   "mft-sim: t = 3.0 s, 1.00x real time, base z 0.4001 m"                    every 1000 ticks
   "mft-sim: a tick waited 3.2 ms for its command: actuators damping (t = 4.123 s)"

@@ -1,23 +1,22 @@
-// mft-estimator: SensorData(k) [+ GroundTruth(k)] -> floating-base state estimate -> RobotState(k).
-// The filter starts from the simulator's initial pose (the robot is placed at a known standing pose); in the
-// scenario's ground_truth mode it passes the simulator's truth through (to tell controller problems from
-// estimator problems).
+// mft-estimator: the estimator stage of the chain (chain/estimator_node.hpp) as a service:
+// SensorData(k) [+ GroundTruth(k)] -> RobotState(k). The filter starts from the simulator's pose at the first
+// tick; in the scenario's ground_truth mode it passes the simulator's truth through.
 #include <chrono>
 #include <cstdio>
 #include <mutex>
 #include <thread>
 
+#include "chain/estimator_node.hpp"
 #include "idl/msg_pubsub.hpp"
-#include "estimator/state_estimator.hpp"
 #include "model/config/strict_yaml.hpp"
+#include "model/config/tool_io.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/hop_trace.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/msg_guard.hpp"
-#include "services/runtime/tick_gate.hpp"
 #include "services/runtime/service_context.hpp"
+#include "services/runtime/tick_join.hpp"
 #include "services/runtime/topic_io.hpp"
-#include "model/config/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;
@@ -28,7 +27,6 @@ static int toolMain(int argc, char** argv) {
   cli.parse(argc, argv);
   services::installShutdownHandlers();
   services::ServiceContext ctx("mft-estimator", cli);
-
   estimator::EstimatorConfig config;
   try {
     config = estimator::loadEstimatorConfig(ctx.configFile("estimator.yaml"));
@@ -36,65 +34,41 @@ static int toolMain(int argc, char** argv) {
     cli.fail(e.what());
   }
   if (ctx.checkOnly()) return ctx.reportConfigOk();
-  config.mode = ctx.scenario().estimator == "ground_truth" ? estimator::EstimatorMode::GroundTruth
-                                                          : estimator::EstimatorMode::Kalman;
-  estimator::StateEstimator estimator(config, ctx.robot());
+  chain::EstimatorNode node(chain::withScenarioMode(config, ctx.scenario().estimator), ctx.robot());
 
   std::mutex mutex;  // the two readers' callbacks may run on different DDS threads
   model::SensorReadings sensors;
   model::GroundTruthState truth;
-  bool have_sensors = false, have_truth = false, initialized = false, answered = false;
-  std::uint64_t last_tick = 0, ticks = 0, refused_inputs = 0;
+  bool have_sensors = false, have_truth = false;
+  services::TickJoin join("mft-estimator");
   services::HopTrace hops("mft-estimator", {"sensor_in", "write", "written"});
-  services::TickGate gate;  // refuses a stray far tick, follows a restarted simulator (tick_gate.hpp)
   msg::RobotState out_msg;
   services::LatencyStats update_us;
   services::TopicWriter<msg::RobotState, msg::RobotStatePubSubType> writer(ctx.participant(), "RobotState",
                                                                            ctx.chainWriterProfile());
-  // Answers tick k once SensorData(k) is here (and GroundTruth(k) when it is needed). Only a repeated
-  // SensorData (the simulator re-sends a tick until the chain answers) gets the cached answer again: the second
-  // input topic of the same tick must not double the chain's traffic.
+  // Tick k once SensorData(k) is here, and GroundTruth(k) when the node needs it.
   auto process = [&](bool sensor_arrived) {
     if (!have_sensors) return;
-    if (answered && sensors.tick == last_tick) {
-      if (sensor_arrived) writer.write(out_msg);
-      return;
-    }
-    if (answered && sensors.tick < last_tick) return;
-    const bool need_truth = !initialized || config.mode == estimator::EstimatorMode::GroundTruth;
-    if (need_truth && !(have_truth && truth.tick == sensors.tick)) return;
+    const bool paired = !node.needsTruth() || (have_truth && truth.tick == sensors.tick);
+    const auto action = join.decide(sensors.tick, paired, sensor_arrived);
+    if (action == services::TickJoin::Action::Resend) writer.write(out_msg);
+    if (action != services::TickJoin::Action::Compute) return;
     const auto t0 = Clock::now();
-    if (!initialized) {
-      estimator.initialize(truth.q.head<3>(), truth.qd.head<3>(), sensors);
-      initialized = true;
-    }
-    const auto& estimate = estimator.update(sensors, need_truth ? &truth : nullptr);
-    services::toMsg(estimate, &out_msg);
+    services::toMsg(node.update(sensors, &truth), &out_msg);
     out_msg.stamp_ns(services::toStampNs(sensors.time_s));
     update_us.add(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
     hops.mark(1, sensors.tick);
     writer.write(out_msg);
     hops.mark(2, sensors.tick);
-    last_tick = sensors.tick;
-    gate.answered(last_tick);
-    answered = true;
-    ++ticks;
+    join.answered(sensors.tick);
   };
   services::TopicReader<msg::SensorData, msg::SensorDataPubSubType> sensor_reader(
       ctx.participant(), "SensorData", ctx.chainReaderProfile(), [&](const msg::SensorData& m) {
         hops.mark(0, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::validInput(m)) {  // a NaN would stay in the filter for good
-          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible SensorData (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
-          return;
-        }
-        const auto decision = gate.check(m.tick());
-        if (decision == services::TickGate::Decision::Refused) return;
-        if (decision == services::TickGate::Decision::NewClock) {
-          std::printf("mft-estimator: the simulator's clock restarted (tick %llu after %llu): re-initializing\n",
-                      static_cast<unsigned long long>(m.tick()), static_cast<unsigned long long>(last_tick));
-          answered = initialized = false;
-        }
+        bool new_clock = false;  // a NaN would stay in the filter for good
+        if (!join.accept(services::validInput(m), "SensorData", m.tick()) || !join.admit(m.tick(), &new_clock)) return;
+        if (new_clock) node.restart();
         services::fromMsg(m, &sensors);
         have_sensors = true;
         process(true);
@@ -102,10 +76,7 @@ static int toolMain(int argc, char** argv) {
   services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
       ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
         std::lock_guard<std::mutex> lock(mutex);
-        if (!services::validInput(m)) {
-          if (refused_inputs++ == 0) std::printf("mft-estimator: refused a non-finite or implausible GroundTruth (tick %llu)\n", static_cast<unsigned long long>(m.tick()));
-          return;
-        }
+        if (!join.accept(services::validInput(m), "GroundTruth", m.tick())) return;
         services::fromMsg(m, &truth);
         have_truth = true;
         process(false);
@@ -117,12 +88,10 @@ static int toolMain(int argc, char** argv) {
   std::lock_guard<std::mutex> lock(mutex);
   char head[256];
   std::snprintf(head, sizeof head, "{\"service\": \"mft-estimator\", \"mode\": \"%s\", \"ticks\": %llu, \"last_tick\": %llu, ",
-                ctx.scenario().estimator.c_str(), static_cast<unsigned long long>(ticks),
-                static_cast<unsigned long long>(last_tick));
-  ctx.writeSummary(std::string(head) + "\"refused_inputs\": " + std::to_string(refused_inputs) +
-                   ", \"refused_ticks\": " + std::to_string(gate.refused()) + ", \"new_clocks\": " + std::to_string(gate.newClocks()) +
-                   ", \"deadline_misses\": " + std::to_string(sensor_reader.requestedDeadlineMisses()) +
-                   ", \"update_time_us\": " + update_us.json() + "}");
+                ctx.scenario().estimator.c_str(), static_cast<unsigned long long>(join.ticks()),
+                static_cast<unsigned long long>(join.lastTick()));
+  ctx.writeSummary(std::string(head) + join.countsJson() + ", \"deadline_misses\": " +
+                   std::to_string(sensor_reader.requestedDeadlineMisses()) + ", \"update_time_us\": " + update_us.json() + "}");
   return 0;
 }
 

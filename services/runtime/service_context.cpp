@@ -5,7 +5,7 @@
 
 #include "model/config/install_layout.hpp"
 #include "model/config/strict_yaml.hpp"
-#include "services/runtime/scenario_limits.hpp"
+#include "chain/scenario_limits.hpp"
 
 namespace mft::services {
 
@@ -39,10 +39,10 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   config_dir_ = cli.get("config-dir");
   summary_file_ = cli.get("summary");
   try {
-    scenario_ = loadScenario(cli.get("scenario"));
-    profile_names_ = activateRunProfiles(config_dir_, scenario_, cli.getAll("profile"));
+    scenario_ = chain::loadScenario(cli.get("scenario"));
+    profile_names_ = chain::activateRunProfiles(config_dir_, scenario_, cli.getAll("profile"));
     robot_ = model::loadRobotDescription(configFile("robot.yaml"));
-    checkScenarioLimits(scenario_, robot_, configFile("planner.yaml"));
+    chain::checkScenarioLimits(scenario_, robot_, configFile("planner.yaml"));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
   }

@@ -124,7 +124,7 @@ TEST(Walking, TracksTheAverageSpeedCommand) {
 TEST(Standing, HoldsHeightAndPitchFor10s) {
   RunOptions o;
   o.stats_from_s = 2.0;
-  const services::Scenario sc = makeScenario(0.40, 0.0, 10.0, "mft", "kalman", 0.0, true);
+  const chain::Scenario sc = makeScenario(0.40, 0.0, 10.0, "mft", "kalman", 0.0, true);
   ASSERT_DOUBLE_EQ(sc.initial_stance_width_m, kStandStanceWidth);
   ClosedLoop loop(configs(), sc, o);
   const RunSummary s = loop.run();

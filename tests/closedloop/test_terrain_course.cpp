@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 #include "sim/terrain.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 
@@ -45,9 +45,9 @@ const sim::TerrainSegment& segmentOf(const sim::Terrain& t, sim::SegmentType typ
 }
 
 // The course's command as mft-experiment terrain gives it: stand 1 s, step in place 1 s, then walk.
-services::Scenario courseScenario() {
-  services::Scenario s = makeScenario(kHeight, 0.0, kDuration, "mft", "kalman", 1.0);
-  s.commands.push_back({2.0, services::LocomotionMode::Walk, kHeight, kSpeed});
+chain::Scenario courseScenario() {
+  chain::Scenario s = makeScenario(kHeight, 0.0, kDuration, "mft", "kalman", 1.0);
+  s.commands.push_back({2.0, chain::LocomotionMode::Walk, kHeight, kSpeed});
   return s;
 }
 

@@ -1,4 +1,4 @@
-// The one push-recovery criterion (services/runtime/push_recovery.hpp, docs/experiments.md "Recovered") on small
+// The one push-recovery criterion (chain/push_recovery.hpp, docs/experiments.md "Recovered") on small
 // synthetic runs: recovered, fell, still drifting, and the cases at the edge of each band.
 #include <gtest/gtest.h>
 
@@ -6,16 +6,16 @@
 #include <functional>
 
 #include "model/config/strict_yaml.hpp"
-#include "services/runtime/push_recovery.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/push_recovery.hpp"
+#include "chain/scenario.hpp"
 
 namespace {
 
-using mft::services::RecoveryCriteria;
-using mft::services::RecoveryOutcome;
-using mft::services::RecoveryRule;
-using mft::services::RecoveryVerdict;
-using mft::services::RecoveryWindow;
+using mft::chain::RecoveryCriteria;
+using mft::chain::RecoveryOutcome;
+using mft::chain::RecoveryRule;
+using mft::chain::RecoveryVerdict;
+using mft::chain::RecoveryWindow;
 
 constexpr double kDt = 0.001;
 
@@ -57,7 +57,7 @@ RecoveryVerdict judge(const Trace& tr, const RecoveryCriteria& c = {}) {
     w.update(s, touchdowns);
   }
   const bool fell = tr.fall_at_s >= 0;
-  return mft::services::judgeRecovery(w.record(), c, fell, fell ? tr.fall_at_s : 0.0, fell ? "base below 0.25 m" : "");
+  return mft::chain::judgeRecovery(w.record(), c, fell, fell ? tr.fall_at_s : 0.0, fell ? "base below 0.25 m" : "");
 }
 
 // A push of a stepping robot: the base runs 0.4 m forward over 1.5 s (smoothly), dips 40 mm and pitches, then
@@ -171,7 +171,7 @@ TEST(PushRecovery, TheWindowIsTheLastWindowOfTheRun) {
 }
 
 TEST(PushRecovery, ScenarioCarriesTheCriteria) {
-  const auto s = mft::services::parseScenario(
+  const auto s = mft::chain::parseScenario(
       "schema_version: 1\nname: t\nduration_s: 8\ncontroller: mft\nestimator: kalman\nterrain: flat\n"
       "initial_base_height_m: 0.42\nfall: {base_height_below_m: 0.25, pitch_beyond_rad: 0.8}\n"
       "recovery: {rule: no_fall, window_s: 2, max_speed_mps: 0.1, height_band_m: 0.03, max_pitch_rad: 0.2, "
@@ -184,7 +184,7 @@ TEST(PushRecovery, ScenarioCarriesTheCriteria) {
   EXPECT_DOUBLE_EQ(s.recovery.height_band_m, 0.03);
   EXPECT_DOUBLE_EQ(s.recovery.max_pitch_rad, 0.2);
   EXPECT_EQ(s.recovery.min_touchdowns, 3);
-  EXPECT_THROW(mft::services::parseScenario(
+  EXPECT_THROW(mft::chain::parseScenario(
                    "schema_version: 1\nname: t\nduration_s: 8\ncontroller: mft\nestimator: kalman\nterrain: flat\n"
                    "initial_base_height_m: 0.42\nfall: {base_height_below_m: 0.25, pitch_beyond_rad: 0.8}\n"
                    "recovery: {rule: maybe}\ncommands:\n  - {at_s: 0, mode: stand, z_cmd_m: 0.42, v_cmd_mps: 0}\n",

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <limits>
 
-#include "services/runtime/input_guard.hpp"
+#include "chain/input_guard.hpp"
 #include "services/runtime/msg_guard.hpp"
 #include "services/runtime/tick_gate.hpp"
 
-using mft::services::checkDisturbance;
-using mft::services::checkJointCommand;
-using mft::services::InputVerdict;
+using mft::chain::checkDisturbance;
+using mft::chain::checkJointCommand;
+using mft::chain::InputVerdict;
 using mft::services::TickGate;
 using mft::services::validInput;
 

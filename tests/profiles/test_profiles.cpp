@@ -10,7 +10,7 @@
 
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 
 namespace mft {
@@ -78,9 +78,9 @@ TEST_F(ProfileDir, LaterProfilesWinInCommandLineOrder) {
   const auto ba = closedloop::loadConfigs(dir_.string(), {"b", "a"});
   EXPECT_DOUBLE_EQ(ba.wbc.weights.slack, 10.0);
   // The scenario's profiles come first, then --profile values (comma lists allowed), each once.
-  services::Scenario s;
+  chain::Scenario s;
   s.profiles = {"b"};
-  EXPECT_EQ(services::runProfiles(s, {"a,b", "c"}), (std::vector<std::string>{"b", "a", "c"}));
+  EXPECT_EQ(chain::runProfiles(s, {"a,b", "c"}), (std::vector<std::string>{"b", "a", "c"}));
 }
 
 TEST_F(ProfileDir, StrictOverlaysAreRefusedWithFileAndKey) {

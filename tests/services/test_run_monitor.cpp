@@ -1,7 +1,7 @@
 // Fall criteria and tracking statistics of a run.
 #include <gtest/gtest.h>
 
-#include "services/runtime/run_monitor.hpp"
+#include "chain/run_monitor.hpp"
 
 using namespace mft;
 
@@ -17,7 +17,7 @@ model::GroundTruthState standing(double t, double z, double pitch) {
 }  // namespace
 
 TEST(RunMonitor, StatisticsStartAfterSettling) {
-  services::RunMonitor m({}, 1.0);
+  chain::RunMonitor m({}, 1.0);
   EXPECT_FALSE(m.update(standing(0.5, 0.30, 0.0), 0.42, 0));  // before settling: not counted
   EXPECT_FALSE(m.update(standing(1.5, 0.43, 0.02), 0.42, 0));
   EXPECT_FALSE(m.update(standing(1.6, 0.41, -0.02), 0.42, 0));
@@ -28,26 +28,26 @@ TEST(RunMonitor, StatisticsStartAfterSettling) {
 }
 
 TEST(RunMonitor, EachFallCriterion) {
-  services::FallCriteria c;
+  chain::FallCriteria c;
   {
-    services::RunMonitor m(c, 0);
+    chain::RunMonitor m(c, 0);
     EXPECT_TRUE(m.update(standing(2.0, 0.2, 0), 0.42, 0));
     EXPECT_NE(m.fallReason().find("base below"), std::string::npos);
     EXPECT_DOUBLE_EQ(m.fallTime(), 2.0);
     EXPECT_FALSE(m.update(standing(2.1, 0.1, 0), 0.42, 0));  // reported once
   }
   {
-    services::RunMonitor m(c, 0);
+    chain::RunMonitor m(c, 0);
     EXPECT_TRUE(m.update(standing(1.0, 0.42, -0.9), 0.42, 0));
     EXPECT_NE(m.fallReason().find("pitch"), std::string::npos);
   }
   {
-    services::RunMonitor m(c, 0);
+    chain::RunMonitor m(c, 0);
     EXPECT_TRUE(m.update(standing(1.0, 0.42, 0), 0.42, 3));
     EXPECT_NE(m.fallReason().find("non-foot body"), std::string::npos);
   }
   {
-    services::RunMonitor m(c, 0);
+    chain::RunMonitor m(c, 0);
     auto s = standing(1.0, 0.42, 0);
     s.lti = {0.8, 0.01};
     EXPECT_TRUE(m.update(s, 0.42, 0));
@@ -56,7 +56,7 @@ TEST(RunMonitor, EachFallCriterion) {
 }
 
 TEST(RunMonitor, AverageSpeed) {
-  services::RunMonitor m({}, 0);
+  chain::RunMonitor m({}, 0);
   auto s = standing(0.0, 0.42, 0);
   m.update(s, 0.42, 0);
   s.time_s = 10.0;

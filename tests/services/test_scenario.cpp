@@ -7,10 +7,10 @@
 #include <sstream>
 
 #include "model/config/strict_yaml.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 
 using mft::config::ConfigError;
-using namespace mft::services;
+using namespace mft::chain;
 
 namespace {
 std::string scenarioDir() { return std::string(MFT_CONFIG_DIR) + "/scenarios"; }

@@ -3,10 +3,11 @@
 
 #include <random>
 
-#include "services/runtime/command_watchdog.hpp"
+#include "chain/command_watchdog.hpp"
 #include "services/runtime/latency_stats.hpp"
 
 using namespace mft::services;
+using namespace mft::chain;
 
 namespace {
 constexpr std::int64_t kMs = 1'000'000;

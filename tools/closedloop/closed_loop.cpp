@@ -1,7 +1,5 @@
 #include "tools/closedloop/closed_loop.hpp"
 
-#include "model/config/profiles.hpp"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,7 +7,6 @@
 #include <sstream>
 
 #include "model/config/profiles.hpp"
-#include "wbc/reference_from_plan.hpp"
 #include "model/config/tool_io.hpp"
 
 namespace mft::closedloop {
@@ -19,31 +16,8 @@ double wallNow() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-planner::LocomotionMode toPlannerMode(services::LocomotionMode m) {
-  switch (m) {
-    case services::LocomotionMode::Stand: return planner::LocomotionMode::Stand;
-    case services::LocomotionMode::StepInPlace: return planner::LocomotionMode::StepInPlace;
-    case services::LocomotionMode::Walk: return planner::LocomotionMode::Walk;
-  }
-  return planner::LocomotionMode::Stand;
-}
-
-wbc::WbcConfig withVariant(wbc::WbcConfig c, const std::string& controller) {
-  if (!wbc::parseVariant(controller, &c.variant))
-    throw std::invalid_argument("closed loop: unknown controller '" + controller + "'");
-  return c;
-}
-
-estimator::EstimatorConfig withMode(estimator::EstimatorConfig c, const std::string& mode) {
-  c.mode = mode == "ground_truth" ? estimator::EstimatorMode::GroundTruth : estimator::EstimatorMode::Kalman;
-  return c;
-}
-
-services::FallCriteria criteriaOf(const services::Scenario& s) {
-  services::FallCriteria c;
-  c.base_height_below_m = s.fall_base_height_m;
-  c.pitch_beyond_rad = s.fall_pitch_rad;
-  return c;
+sim::Terrain terrainOf(const Configs& configs, const chain::Scenario& scenario, const RunOptions& options) {
+  return options.terrain ? *options.terrain : sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml");
 }
 
 }  // namespace
@@ -62,10 +36,10 @@ Configs loadConfigs(const std::string& dir, const std::vector<std::string>& prof
   return c;
 }
 
-services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
+chain::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
                                 const std::string& estimator, double step_at_s, bool stand_only,
                                 double stance_width_m) {
-  services::Scenario s;
+  chain::Scenario s;
   s.name = stand_only ? "stand" : (speed_mps != 0.0 ? "walk" : "step-in-place");
   s.description = "built by mft-closedloop";
   s.duration_s = duration_s;
@@ -76,45 +50,23 @@ services::Scenario makeScenario(double height_m, double speed_mps, double durati
   s.initial_stance_width_m = stance_width_m >= 0.0 ? stance_width_m : (stand_only ? kStandStanceWidth : 0.0);
   s.fall_base_height_m = 0.25;  // the scenario files' values
   s.fall_pitch_rad = 0.8;
-  s.commands.push_back({0.0, services::LocomotionMode::Stand, height_m, 0.0});
+  s.commands.push_back({0.0, chain::LocomotionMode::Stand, height_m, 0.0});
   if (!stand_only)
     s.commands.push_back({step_at_s,
-                          speed_mps != 0.0 ? services::LocomotionMode::Walk : services::LocomotionMode::StepInPlace,
+                          speed_mps != 0.0 ? chain::LocomotionMode::Walk : chain::LocomotionMode::StepInPlace,
                           height_m, speed_mps});
   return s;
 }
 
-ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenario, const RunOptions& options)
-    : configs_(configs),
-      scenario_(scenario),
-      options_(options),
-      terrain_(options.terrain ? *options.terrain
-                               : sim::loadTerrain(configs.config_dir + "/terrain/" + scenario.terrain + ".yaml")),
-      state_builder_(configs.robot),
-      monitor_(criteriaOf(scenario), options.stats_from_s),
-      recovery_(scenario.recovery.window_s, configs.sim.control_period_s) {
-  sim_ = std::make_unique<sim::Simulator>(configs_.robot, configs_.sim, terrain_);
-  sim::StandingPose pose;
-  pose.base_height_m = scenario_.initial_base_height_m;
-  // mft-sim's start: the scenario's stance width, right foot ahead, centred under the base.
-  pose.foot_offset_x_m = {0.5 * scenario_.initial_stance_width_m, -0.5 * scenario_.initial_stance_width_m};
-  sim_->reset(pose);
-  estimator_ = std::make_unique<estimator::StateEstimator>(withMode(configs_.estimator, scenario_.estimator),
-                                                           configs_.robot);
-  planner_ = std::make_unique<planner::MotionPlanner>(configs_.planner, configs_.robot);
-  wbc_ = std::make_unique<wbc::WholeBodyController>(configs_.robot, withVariant(configs_.wbc, scenario_.controller),
-                                                    &configs_.polytope);
-  // Pushes as mft-sim plays them: at a time straight away; at a lift-off armed only from their time on.
-  for (const auto& p : scenario_.pushes) {
-    sim::ImpulseSpec spec;
-    spec.impulse_Ns = {p.impulse_Ns, 0.0};
-    spec.time_s = p.at_s;
-    spec.trigger = p.at_liftoff_leg < 0 ? sim::ImpulseTrigger::AtTime : sim::ImpulseTrigger::AtLiftOff;
-    spec.leg = std::max(0, p.at_liftoff_leg);
-    if (spec.trigger == sim::ImpulseTrigger::AtTime) sim_->scheduleImpulse(spec);
-    else armed_pushes_.emplace_back(p.at_s, spec);
-  }
-  ticks_total_ = static_cast<std::uint64_t>(std::llround(scenario_.duration_s / configs_.sim.control_period_s));
+ClosedLoop::ClosedLoop(const Configs& configs, const chain::Scenario& scenario, const RunOptions& options)
+    : configs_(configs), scenario_(scenario), options_(options) {
+  sim_ = std::make_unique<chain::SimNode>(configs_.robot, configs_.sim, terrainOf(configs_, scenario_, options_), scenario_,
+                                          options_.stats_from_s);
+  estimator_ = std::make_unique<chain::EstimatorNode>(chain::withScenarioMode(configs_.estimator, scenario_.estimator),
+                                                      configs_.robot);
+  planner_ = std::make_unique<chain::PlannerNode>(configs_.planner, configs_.robot, scenario_);
+  wbc_ = std::make_unique<chain::WbcNode>(configs_.robot, chain::withScenarioController(configs_.wbc, scenario_.controller),
+                                          configs_.polytope);
   z_cmd_ = scenario_.commands.front().z_cmd_m;
   summary_.min_base_z = 1e9;
   summary_.max_base_z = -1e9;
@@ -124,77 +76,43 @@ ClosedLoop::ClosedLoop(const Configs& configs, const services::Scenario& scenari
 
 ClosedLoop::~ClosedLoop() = default;
 
+// Tick k in the lockstep stack's order: estimate(k) -> the scenario's commands due at t_k -> plan(k) ->
+// command(k) -> the simulator's step (due pushes armed) -> the fall check on truth(k + 1).
 bool ClosedLoop::step() {
   if (finished_) return false;
-  if (sim_->tick() >= ticks_total_) {
+  if (sim_->tick() >= sim_->ticksTotal()) {
     finished_ = true;
     return false;
   }
-  const model::SensorReadings& sensors = sim_->sensors();
-  const model::GroundTruthState& truth = sim_->groundTruth();
-  truth_at_estimate_ = truth;
-
-  // Estimator: started from the simulator's initial pose, as mft-estimator does.
-  if (!estimator_initialized_) {
-    estimator_->initialize(truth.q.head<3>(), truth.qd.head<3>(), sensors);
-    estimator_initialized_ = true;
-  }
-  estimate_ = estimator_->update(sensors, &truth);
-
-  // Planner, with the scenario's commands due by now (mft-planner's rule).
-  while (next_command_ < scenario_.commands.size() &&
-         scenario_.commands[next_command_].at_s <= estimate_.time_s + 1e-9) {
-    const auto& c = scenario_.commands[next_command_++];
-    const auto result = planner_->setCommand({c.z_cmd_m, c.v_cmd_mps, toPlannerMode(c.mode)});
-    if (!result.accepted) std::fprintf(stderr, "closed loop: command rejected: %s\n", result.reason.c_str());
-  }
-  const planner::PlanOutput& plan = planner_->update(state_builder_.build(estimate_));
-  reference_ = wbc::referenceFromPlan(plan);
-  reference_.tick = estimate_.tick;
-
-  command_ = wbc_->update(estimate_, reference_, &diag_);
-  command_.tick = estimate_.tick;
-
-  for (auto it = armed_pushes_.begin(); it != armed_pushes_.end();) {
-    if (it->first <= sim_->time() + 1e-9) {
-      sim_->scheduleImpulse(it->second);
-      it = armed_pushes_.erase(it);
-    } else {
-      ++it;
-    }
-  }
-  sim_->setCommand(command_);
-  sim_->step();
-
+  truth_at_estimate_ = sim_->truth();
+  estimate_ = estimator_->update(sim_->sensors(), &truth_at_estimate_);
+  planner_->applyScenarioCommands(estimate_.time_s, [](const planner::OperatorCommand&, const planner::CommandResult& r) {
+    if (!r.accepted) std::fprintf(stderr, "closed loop: command rejected: %s\n", r.reason.c_str());
+  });
+  const bool fell_now = sim_->step(wbc_->update(estimate_, planner_->plan(estimate_)));
   // mft-sim's height command for the statistics: the one in force at the new time.
-  for (const auto& c : scenario_.commands)
-    if (c.at_s <= sim_->time()) z_cmd_ = c.z_cmd_m;
-  const bool fell_now = monitor_.update(sim_->groundTruth(), z_cmd_, sim_->stats().body_contact_steps);
-  {  // as mft-sim does it
-    const auto& st = sim_->stats();
-    for (; impulses_seen_ < st.impulses.size(); ++impulses_seen_)
-      recovery_.onImpulse(st.impulses[impulses_seen_].time_s, st.impulses[impulses_seen_].impulse_Ns.x());
-    recovery_.update(sim_->groundTruth(), st.touchdowns[0] + st.touchdowns[1]);
-  }
+  z_cmd_ = chain::commandedHeight(scenario_, sim_->time());
   accumulate();
   if (fell_now && options_.stop_at_fall) finished_ = true;
-  if (sim_->tick() >= ticks_total_) finished_ = true;
+  if (sim_->tick() >= sim_->ticksTotal()) finished_ = true;
   return !finished_;
 }
 
 void ClosedLoop::accumulate() {
   RunSummary& s = summary_;
-  const auto& truth = sim_->groundTruth();
+  const auto& truth = sim_->truth();
+  const auto& monitor = sim_->monitor();
+  const auto& diag = wbc_->diagnostics();
   s.ticks = sim_->tick();
   s.sim_time_s = sim_->time();
   s.wall_time_s = wallNow() - wall_start_;
-  s.fell = monitor_.fell();
-  s.fall_time_s = monitor_.fallTime();
-  s.fall_reason = monitor_.fallReason();
-  s.body_contact_steps = sim_->stats().body_contact_steps;
-  if (diag_.qp_attempted && diag_.status != qp::QpStatus::Optimal) ++s.non_optimal_solves;
-  if (diag_.safety_event != wbc::SafetyEvent::None) ++s.safety_events;
-  if (diag_.torque_clamped) ++s.torque_clamped_ticks;
+  s.fell = monitor.fell();
+  s.fall_time_s = monitor.fallTime();
+  s.fall_reason = monitor.fallReason();
+  s.body_contact_steps = sim_->simulator().stats().body_contact_steps;
+  if (diag.qp_attempted && diag.status != qp::QpStatus::Optimal) ++s.non_optimal_solves;
+  if (diag.safety_event != wbc::SafetyEvent::None) ++s.safety_events;
+  if (diag.torque_clamped) ++s.torque_clamped_ticks;
   const auto& plan = planner_->output();
   if (plan.step_index != last_step_seen_) {
     if (last_step_seen_ > 0) {
@@ -212,7 +130,7 @@ void ClosedLoop::accumulate() {
   // The window: statistics of the truth after the tick, and of the estimate the controller used against the
   // truth it was computed from.
   const double t = sim_->time();
-  if (t < options_.stats_from_s - 1e-9 || monitor_.fell()) return;
+  if (t < options_.stats_from_s - 1e-9 || monitor.fell()) return;
   if (n_window_ == 0) {
     window_x0_ = truth.q[model::kBaseX];
     window_t0_ = t;
@@ -256,14 +174,9 @@ const RunSummary& ClosedLoop::run(const std::function<void(const ClosedLoop&)>& 
   return summary_;
 }
 
-services::RecoveryVerdict ClosedLoop::recoveryVerdict() const {
-  return services::judgeRecovery(recovery_.record(), scenario_.recovery, monitor_.fell(), monitor_.fallTime(),
-                                 monitor_.fallReason());
-}
+chain::RecoveryVerdict ClosedLoop::recoveryVerdict() const { return sim_->recoveryVerdict(); }
 
-std::string ClosedLoop::recoveryJson() const {
-  return recovery_.json(scenario_.recovery, monitor_.fell(), monitor_.fallTime(), monitor_.fallReason());
-}
+std::string ClosedLoop::recoveryJson() const { return sim_->recoveryJson(); }
 
 std::string RunSummary::toJson() const {
   // Window figures are null when the window holds no sample (the run ended before it began): their
@@ -297,33 +210,54 @@ std::string ClosedLoop::csvHeader() {
          "sea0,sea1,sea2,sea3,motor_tau0,motor_tau1,motor_tau2,motor_tau3,motor_w0,motor_w1,motor_w2,motor_w3";
 }
 
+std::string ClosedLoop::trajectoryHeader() {
+  return "tick,x,z,pitch,q4,q5,q6,q7,q8,q9,q10,q11,tau_q4,tau_q6,tau_q8,tau_q10";
+}
+
+std::string ClosedLoop::trajectoryRow() const {
+  std::string row = std::to_string(truth_at_estimate_.tick);
+  char v[32];
+  for (int i = 0; i < model::kNq; ++i) {
+    std::snprintf(v, sizeof v, ",%.17g", truth_at_estimate_.q[i]);
+    row += v;
+  }
+  for (int i = 0; i < model::kNa; ++i) {
+    std::snprintf(v, sizeof v, ",%.17g", wbc_->command().tau[i]);
+    row += v;
+  }
+  return row;
+}
+
 std::string ClosedLoop::csvRow() const {
   const auto& tr = truth_at_estimate_;
   const auto& e = estimate_;
   const auto& p = planner_->output();
+  const auto& reference = planner_->reference();
+  const auto& diag = wbc_->diagnostics();
+  const auto& sim = sim_->simulator();
   std::ostringstream o;
   o.precision(7);
   o << tr.time_s;
   for (int i = 0; i < 6; ++i) o << ',' << (i < 3 ? tr.q[i] : tr.qd[i - 3]);
   for (int i = 3; i < model::kNq; ++i) o << ',' << tr.q[i];
   o << ',' << e.q[0] << ',' << e.q[1] << ',' << e.q[2] << ',' << e.qd[0] << ',' << e.qd[1];
-  o << ',' << reference_.base_z.pos << ',' << reference_.base_pitch.pos << ',' << z_cmd_;
+  o << ',' << reference.base_z.pos << ',' << reference.base_pitch.pos << ',' << z_cmd_;
   o << ',' << p.stance_leg << ',' << p.phase << ',' << p.step_index << ',' << (p.swing_extended ? 1 : 0);
-  o << ',' << reference_.foot_in_stance[0] << ',' << reference_.foot_in_stance[1];
-  for (int i = 0; i < model::kNc; ++i) o << ',' << reference_.foot_pos[i];
-  const auto& md = wbc_->modelData();  // the controller's model at the estimate
+  o << ',' << reference.foot_in_stance[0] << ',' << reference.foot_in_stance[1];
+  for (int i = 0; i < model::kNc; ++i) o << ',' << reference.foot_pos[i];
+  const auto& md = wbc_->controller().modelData();  // the controller's model at the estimate
   for (int i = 0; i < model::kNc; ++i) o << ',' << md.foot_pos[i];
   o << ',' << (tr.contact_force[1] > configs_.sim.contact_switch_threshold_N) << ','
     << (tr.contact_force[3] > configs_.sim.contact_switch_threshold_N);
   o << ',' << e.contact[0] << ',' << e.contact[1];
   o << ',' << tr.contact_force[1] << ',' << tr.contact_force[3] << ',' << tr.contact_force[0] << ','
     << tr.contact_force[2];
-  o << ',' << diag_.f_c[1] << ',' << diag_.f_c[3];
-  for (int i = 0; i < model::kNa; ++i) o << ',' << command_.tau[i];
-  o << ',' << static_cast<int>(diag_.status) << ',' << diag_.slack_norm << ',' << diag_.mft_violation;
+  o << ',' << diag.f_c[1] << ',' << diag.f_c[3];
+  for (int i = 0; i < model::kNa; ++i) o << ',' << wbc_->command().tau[i];
+  o << ',' << static_cast<int>(diag.status) << ',' << diag.slack_norm << ',' << diag.mft_violation;
   o << ',' << tr.lti[0] << ',' << tr.lti[1] << ',' << p.target_x;
   // The actuators over the last step: the spring torque on the hips, the drive's torque and speed.
-  const model::VectorA sea = sim_->seaTorque(), motor = sim_->motorTorque(), speed = sim_->motorSpeed();
+  const model::VectorA sea = sim.seaTorque(), motor = sim.motorTorque(), speed = sim.motorSpeed();
   for (const auto* v : {&sea, &motor, &speed})
     for (int i = 0; i < model::kNa; ++i) o << ',' << (*v)[i];
   return o.str();

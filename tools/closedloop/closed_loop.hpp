@@ -1,8 +1,8 @@
 #pragma once
 // In-process closed loop (issue 6): simulator -> estimator -> planner -> WBC -> simulator, all on the sim clock
-// in one thread, with the configs, the PlanOutput -> WbcReference mapping (wbc/reference_from_plan.hpp), the
-// scenario loader and the fall criteria (services/runtime) that the DDS stack uses. A tuning and test bench:
-// deterministic, about 10-30x faster than real time, no processes. Not the product path (that is services/).
+// in one thread: the control chain's nodes (chain/) that the DDS services drive over topics, with the same
+// configs, scenario, reference mapping and fall criteria. A tuning and test bench: deterministic, about 10-30x
+// faster than real time, no processes. Not the product path (that is services/).
 //
 // Tick k, as in the lockstep stack: sensors(k) [+ truth(k)] -> estimate(k) -> scenario commands due at t_k ->
 // plan(k) -> reference(k) -> command(k) -> pushes armed by t_k -> sim.step() -> fall check on truth(k + 1).
@@ -12,18 +12,16 @@
 #include <string>
 #include <vector>
 
-#include "estimator/state_estimator.hpp"
+#include "chain/estimator_node.hpp"
+#include "chain/planner_node.hpp"
+#include "chain/scenario.hpp"
+#include "chain/sim_node.hpp"
+#include "chain/wbc_node.hpp"
 #include "model/mft_polytope.hpp"
 #include "model/robot_description.hpp"
-#include "planner/motion_planner.hpp"
-#include "services/runtime/push_recovery.hpp"
-#include "services/runtime/run_monitor.hpp"
-#include "services/runtime/scenario.hpp"
 #include "sim/sim_options.hpp"
-#include "sim/simulator.hpp"
 #include "sim/terrain.hpp"
 #include "wbc/wbc_config.hpp"
-#include "wbc/whole_body_controller.hpp"
 
 namespace mft::closedloop {
 
@@ -47,7 +45,7 @@ Configs loadConfigs(const std::string& config_dir, const std::vector<std::string
 // initial_stance_width_m, as mft-sim uses it) is kStandStanceWidth for a stand-only scenario (like
 // config/scenarios/stand.yaml), else 0 (both feet under the hip axis); a negative stance_width_m means that default.
 constexpr double kStandStanceWidth = 0.12;
-services::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
+chain::Scenario makeScenario(double height_m, double speed_mps, double duration_s, const std::string& controller,
                                 const std::string& estimator, double step_at_s = 1.0, bool stand_only = false,
                                 double stance_width_m = -1.0);
 
@@ -87,7 +85,7 @@ struct RunSummary {
 
 class ClosedLoop {
  public:
-  ClosedLoop(const Configs& configs, const services::Scenario& scenario, const RunOptions& options = {});
+  ClosedLoop(const Configs& configs, const chain::Scenario& scenario, const RunOptions& options = {});
   ~ClosedLoop();
 
   // One control tick. Returns false once the run is over (duration reached, or a fall with stop_at_fall).
@@ -97,56 +95,50 @@ class ClosedLoop {
   bool finished() const { return finished_; }
 
   const RunSummary& summary() const { return summary_; }
-  const services::Scenario& scenario() const { return scenario_; }
+  const chain::Scenario& scenario() const { return scenario_; }
   const Configs& configs() const { return configs_; }
-  const sim::Simulator& simulator() const { return *sim_; }
-  const estimator::StateEstimator& estimator() const { return *estimator_; }
-  const planner::MotionPlanner& planner() const { return *planner_; }
-  const wbc::WholeBodyController& controller() const { return *wbc_; }
-  const services::RunMonitor& monitor() const { return monitor_; }
-  // The push-recovery record and verdict (services/runtime/push_recovery.hpp) under the scenario's criteria,
+  const sim::Simulator& simulator() const { return sim_->simulator(); }
+  const estimator::StateEstimator& estimator() const { return estimator_->estimator(); }
+  const planner::MotionPlanner& planner() const { return planner_->planner(); }
+  const wbc::WholeBodyController& controller() const { return wbc_->controller(); }
+  const chain::RunMonitor& monitor() const { return sim_->monitor(); }
+  // The push-recovery record and verdict (chain/push_recovery.hpp) under the scenario's criteria,
   // exactly as mft-sim reports them in its summary's "recovery" section.
-  const services::RecoveryWindow& recoveryWindow() const { return recovery_; }
-  services::RecoveryVerdict recoveryVerdict() const;
+  const chain::RecoveryWindow& recoveryWindow() const { return sim_->recovery(); }
+  chain::RecoveryVerdict recoveryVerdict() const;
   std::string recoveryJson() const;
   // This tick's data (valid after the first step()): what the controller saw and did.
   const model::RobotStateEstimate& estimate() const { return estimate_; }
   const model::GroundTruthState& truthAtEstimate() const { return truth_at_estimate_; }
   const planner::PlanOutput& plan() const { return planner_->output(); }
-  const wbc::WbcReference& reference() const { return reference_; }
-  const wbc::WbcDiagnostics& diagnostics() const { return diag_; }
-  const model::ActuatorCommand& command() const { return command_; }
+  const wbc::WbcReference& reference() const { return planner_->reference(); }
+  const wbc::WbcDiagnostics& diagnostics() const { return wbc_->diagnostics(); }
+  const model::ActuatorCommand& command() const { return wbc_->command(); }
   double commandedHeight() const { return z_cmd_; }
 
   // CSV trace: header() once, then row() per tick (truth, estimate, reference, plan, WBC).
   static std::string csvHeader();
   std::string csvRow() const;
+  // The lockstep trajectory at full precision (%.17g), per tick k: the truth of tick k (what mft-sim publishes
+  // as GroundTruth(k)) and command(k): tick,x,z,pitch,q4..q11,tau_q4,tau_q6,tau_q8,tau_q10. Compared with a DDS
+  // stack's recording of the same scenario (tests/closedloop/test_inprocess_vs_dds.py).
+  static std::string trajectoryHeader();
+  std::string trajectoryRow() const;
 
  private:
   void accumulate();
 
   Configs configs_;
-  services::Scenario scenario_;
+  chain::Scenario scenario_;
   RunOptions options_;
-  sim::Terrain terrain_;
-  std::unique_ptr<sim::Simulator> sim_;
-  std::unique_ptr<estimator::StateEstimator> estimator_;
-  std::unique_ptr<planner::MotionPlanner> planner_;
-  planner::PlannerStateBuilder state_builder_;
-  std::unique_ptr<wbc::WholeBodyController> wbc_;
-  services::RunMonitor monitor_;
-  services::RecoveryWindow recovery_;
-  std::size_t impulses_seen_ = 0;
-  std::vector<std::pair<double, sim::ImpulseSpec>> armed_pushes_;
-  std::size_t next_command_ = 0;
-  std::uint64_t ticks_total_ = 0;
-  bool estimator_initialized_ = false, finished_ = false;
+  std::unique_ptr<chain::SimNode> sim_;
+  std::unique_ptr<chain::EstimatorNode> estimator_;
+  std::unique_ptr<chain::PlannerNode> planner_;
+  std::unique_ptr<chain::WbcNode> wbc_;
+  bool finished_ = false;
   double z_cmd_ = 0.0;
   model::RobotStateEstimate estimate_;
   model::GroundTruthState truth_at_estimate_;
-  wbc::WbcReference reference_;
-  wbc::WbcDiagnostics diag_;
-  model::ActuatorCommand command_;
   planner::TouchdownKind last_touchdown_seen_ = planner::TouchdownKind::None;
   std::uint64_t last_step_seen_ = 0;
 

@@ -10,15 +10,15 @@
 #include <fstream>
 
 #include "model/config/strict_yaml.hpp"
-#include "services/runtime/scenario_limits.hpp"
-#include "services/runtime/process.hpp"
+#include "chain/scenario_limits.hpp"
+#include "model/config/command_line.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 #include "model/config/tool_io.hpp"
 
 using namespace mft;
 
 static int toolMain(int argc, char** argv) {
-  services::CommandLine cli(
+  config::CommandLine cli(
       "mft-closedloop",
       "Run sim -> estimator -> planner -> WBC in one process on the sim clock, with the stack's configs, reference\n"
       "mapping and fall criteria. Without --scenario: stand at --height until --step-at, then step in place\n"
@@ -47,6 +47,7 @@ static int toolMain(int argc, char** argv) {
   cli.flag("continue-after-fall", "keep running after a fall");
   cli.option("csv", "write a per-tick trace to this CSV file");
   cli.option("csv-every", "write every n-th tick to the CSV", "1");
+  cli.option("trajectory", "write the full-precision trajectory (truth of tick k, command k) to this CSV file");
   cli.flag("json", "print the summary as JSON (default: a short text summary)");
   cli.option("dump-qp", "write the WBC's QP of the ticks in the dump window to this existing folder as WBCQP files "
              "(docs/qp-instances.md)");
@@ -56,10 +57,10 @@ static int toolMain(int argc, char** argv) {
   cli.parse(argc, argv);
 
   closedloop::Configs configs;
-  services::Scenario scenario;
+  chain::Scenario scenario;
   try {
     if (cli.isSet("scenario")) {
-      scenario = services::loadScenario(cli.get("scenario"));
+      scenario = chain::loadScenario(cli.get("scenario"));
       if (cli.isSet("no-scenario-profiles")) scenario.profiles.clear();
     } else {
       const double h = cli.isSet("height") ? cli.getDouble("height", 0.1, 1.0) : 0.42;
@@ -68,7 +69,7 @@ static int toolMain(int argc, char** argv) {
       scenario = closedloop::makeScenario(h, v, d, "mft", "kalman", cli.getDouble("step-at", 0.0, 3600.0),
                                           cli.isSet("stand"));
     }
-    scenario.profiles = services::runProfiles(scenario, cli.getAll("profile"));
+    scenario.profiles = chain::runProfiles(scenario, cli.getAll("profile"));
     configs = closedloop::loadConfigs(cli.get("config-dir"), scenario.profiles);
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
@@ -83,7 +84,7 @@ static int toolMain(int argc, char** argv) {
     if (cli.isSet("speed")) {
       const double v = cli.getDouble("speed", -3.0, 3.0);
       for (auto& c : scenario.commands)
-        if (c.mode == services::LocomotionMode::Walk) c.v_cmd_mps = v;
+        if (c.mode == chain::LocomotionMode::Walk) c.v_cmd_mps = v;
     }
     if (cli.isSet("duration")) scenario.duration_s = cli.getDouble("duration", 0.001, 3600.0);
   }
@@ -94,14 +95,14 @@ static int toolMain(int argc, char** argv) {
   if (scenario.estimator != "kalman" && scenario.estimator != "ground_truth")
     cli.fail("--estimator: expected kalman or ground_truth");
   if (cli.isSet("push")) {
-    services::ScenarioPush p;
+    chain::ScenarioPush p;
     p.impulse_Ns = cli.getDouble("push", -100.0, 100.0);
     p.at_s = cli.getDouble("push-at", 0.0, 3600.0);
     p.at_liftoff_leg = cli.isSet("push-timed") ? -1 : 0;
     scenario.pushes.push_back(p);
   }
 
-  if (cli.isSet("recovery-rule") && !services::parseRecoveryRule(cli.get("recovery-rule"), &scenario.recovery.rule))
+  if (cli.isSet("recovery-rule") && !chain::parseRecoveryRule(cli.get("recovery-rule"), &scenario.recovery.rule))
     cli.fail("--recovery-rule: expected stepping or no_fall");
 
   closedloop::RunOptions options;
@@ -111,7 +112,7 @@ static int toolMain(int argc, char** argv) {
   // As the stack does (mft-sim --check-scenario): the start pose in the legs' reach, the commands inside
   // what the planner accepts.
   try {
-    services::checkScenarioLimits(scenario, configs.robot,
+    chain::checkScenarioLimits(scenario, configs.robot,
                                   planner::commandLimits(configs.robot, configs.planner.command, configs.planner.source_file));
   } catch (const config::ConfigError& e) {
     cli.fail(e.what());
@@ -130,6 +131,12 @@ static int toolMain(int argc, char** argv) {
     if (!csv) cli.fail("cannot write " + cli.get("csv"));
     csv << closedloop::ClosedLoop::csvHeader() << "\n";
   }
+  std::ofstream trajectory;
+  if (cli.isSet("trajectory")) {
+    trajectory.open(cli.get("trajectory"));
+    if (!trajectory) cli.fail("cannot write " + cli.get("trajectory"));
+    trajectory << closedloop::ClosedLoop::trajectoryHeader() << "\n";
+  }
   // QP dump window in ticks; writing files is fine here: this loop runs on the sim clock, not in real time.
   const bool dump = cli.isSet("dump-qp");
   const std::string dump_dir = cli.get("dump-qp"), dump_name = cli.get("dump-name");
@@ -146,6 +153,7 @@ static int toolMain(int argc, char** argv) {
   long n = 0;
   const auto& s = loop->run([&](const closedloop::ClosedLoop& l) {
     if (csv.is_open() && n++ % every == 0) csv << l.csvRow() << "\n";
+    if (trajectory.is_open()) trajectory << l.trajectoryRow() << "\n";
     const wbc::WholeBodyController& c = l.controller();
     if (!dump || !dump_error.empty() || !c.hasLastProblem()) return;
     const std::uint64_t tick = c.lastProblemTick();
@@ -170,7 +178,7 @@ static int toolMain(int argc, char** argv) {
   } else {
     std::printf("%s (%s, %s estimator%s%s): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
                 scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",
-                scenario.profiles.empty() ? "" : services::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
+                scenario.profiles.empty() ? "" : chain::profilesJson(scenario.profiles).c_str(), s.fell ? "FELL" : "ok", s.fell ? s.fall_time_s : s.sim_time_s,
                 s.fell ? ": " : "", s.fall_reason.c_str());
     // An empty statistics window (the run ended before --stats-from) has no figures: n/a, not placeholders.
     const bool have = s.window_samples > 0;
@@ -200,7 +208,7 @@ static int toolMain(int argc, char** argv) {
     if (!scenario.pushes.empty()) {
       const auto v = loop->recoveryVerdict();
       std::printf("  push: %s (%s; rule %s)\n", v.recovered ? "RECOVERED" : "NOT RECOVERED", v.reason.c_str(),
-                  services::toString(scenario.recovery.rule));
+                  chain::toString(scenario.recovery.rule));
     }
   }
   return s.fell ? 1 : 0;

@@ -25,8 +25,8 @@
 #include "model/mft_polytope.hpp"
 #include "model/robot_description.hpp"
 #include "services/record/rawlog_reader.hpp"
-#include "services/runtime/input_guard.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/input_guard.hpp"
+#include "chain/scenario.hpp"
 #include "sim/terrain.hpp"
 #include "tools/mft-export/robot_drawing.hpp"
 
@@ -124,7 +124,7 @@ class Panel {
     terrain_ = sim::Terrain::flat();
     if (const std::string* scen = text("scenario")) {
       try {
-        scenario_ = services::parseScenario(*scen, "recorded scenario");
+        scenario_ = chain::parseScenario(*scen, "recorded scenario");
         for (const auto& p : scenario_->pushes) pushes_.push_back({p.impulse_Ns, p.at_liftoff_leg, p.at_s});
         const std::string terrain_key = "terrain/" + scenario_->terrain + ".yaml";
         if (const std::string* t = text(terrain_key)) terrain_ = sim::parseTerrain(*t, "recorded " + terrain_key);
@@ -195,8 +195,8 @@ class Panel {
           // A push sent on the topic (mft-cmd --push): armed when it arrived (its stamp is the newest
           // simulated time the recorder had seen), applied as the simulator does.
           const auto& d = std::get<msg::Disturbance>(m);
-          if (services::checkDisturbance(d.impulse(), d.trigger(), d.time_s(), d.leg(), kSimMaxPushNs) !=
-              services::InputVerdict::Ok)
+          if (chain::checkDisturbance(d.impulse(), d.trigger(), d.time_s(), d.leg(), kSimMaxPushNs) !=
+              chain::InputVerdict::Ok)
             break;
           const double arrived = static_cast<double>(unix_ns - metadata().time_base_unix_ns) * 1e-9;
           if (d.trigger() == msg::TRIGGER_AT_TIME) pushes_.push_back({d.impulse(), -1, std::max(arrived, d.time_s())});
@@ -288,7 +288,7 @@ class Panel {
   model::RobotDescription robot_;
   std::unique_ptr<RobotDrawer> drawer_;
   std::optional<model::MftPolytope> polytope_;
-  std::optional<services::Scenario> scenario_;
+  std::optional<chain::Scenario> scenario_;
   sim::Terrain terrain_;
   std::vector<PushEvent> pushes_;
   msg::GroundTruth gt_;

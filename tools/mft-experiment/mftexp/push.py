@@ -2,9 +2,9 @@
 
 A run: stand 1 s, step in place from 1 s at the reference height, a sagittal impulse on the torso at the first
 lift-off of the chosen foot after `push_after_s`, then `observe_s` more seconds. Fall = the stack's own
-criteria (mft-sim, services/runtime/run_monitor.hpp): base below 0.25 m, |pitch| > 0.8 rad, a thigh, shank or
+criteria (mft-sim, chain/run_monitor.hpp): base below 0.25 m, |pitch| > 0.8 rad, a thigh, shank or
 the torso touching the ground, or a leg at a singular configuration (LTI < 0.02). Recovered: the verdict of the
-project's one criterion (services/runtime/push_recovery.hpp), computed by mft-sim (or mft-closedloop) with the
+project's one criterion (chain/push_recovery.hpp), computed by mft-sim (or mft-closedloop) with the
 criteria written into the scenario's recovery: section. Rule "stepping" (default): no fall until the end AND back
 to stepping in place over the last `window` second: |mean base speed| <= max_speed, |mean base height - mean base
 height over the second before the push| <= height_band, |pitch| <= max_pitch, at least min_touchdowns touchdowns.

@@ -2,7 +2,7 @@
 
 I_max follows the paper: on the grid I_k = start + k * step (3 N s, 0.1 N s), the largest impulse before the
 first failure. "Failure" is the project's one recovery criterion (--recovery-rule, default: back to stepping in
-place; services/runtime/push_recovery.hpp). Search per cell (height, controller):
+place; chain/push_recovery.hpp). Search per cell (height, controller):
   linear (default): the paper's procedure literally: I_0, I_1, ... until the first failure; exact by definition.
     Then --above N s more on the same grid, to report recoveries above the first failure where they exist.
   coarse: a linear scan on the coarse grid (--coarse, 0.5 N s) until its first failure, then the fine grid

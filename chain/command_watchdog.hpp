@@ -8,7 +8,7 @@
 // nanoseconds of a monotonic clock; pure logic, no clock or DDS inside, so it is unit-tested directly.
 #include <cstdint>
 
-namespace mft::services {
+namespace mft::chain {
 
 class CommandWatchdog {
  public:
@@ -58,4 +58,4 @@ class CommandWatchdog {
   std::uint64_t deadline_misses_ = 0, lost_commands_ = 0, recoveries_ = 0;
 };
 
-}  // namespace mft::services
+}  // namespace mft::chain

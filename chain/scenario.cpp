@@ -1,4 +1,4 @@
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,27 +7,18 @@
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
 #include "model/config/tool_io.hpp"
+#include "planner/planner_config.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
 using config::StrictNode;
-
-const char* toString(LocomotionMode m) {
-  switch (m) {
-    case LocomotionMode::Stand: return "stand";
-    case LocomotionMode::StepInPlace: return "step_in_place";
-    case LocomotionMode::Walk: return "walk";
-  }
-  return "?";
-}
 
 namespace {
 
 LocomotionMode parseMode(StrictNode& n, const std::string& key) {
   const std::string s = n.text(key);
-  if (s == "stand") return LocomotionMode::Stand;
-  if (s == "step_in_place") return LocomotionMode::StepInPlace;
-  if (s == "walk") return LocomotionMode::Walk;
+  LocomotionMode mode;
+  if (planner::parseLocomotionMode(s, &mode)) return mode;
   n.fail(key, "unknown mode '" + s + "' (expected stand, step_in_place or walk)");
 }
 
@@ -168,4 +159,4 @@ std::string Scenario::toJson() const {
   return o.str();
 }
 
-}  // namespace mft::services
+}  // namespace mft::chain

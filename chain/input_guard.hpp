@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
-namespace mft::services {
+namespace mft::chain {
 
 enum class InputVerdict { Ok, NonFinite, OutOfRange, BadEnum };
 
@@ -42,4 +42,4 @@ inline InputVerdict checkDisturbance(double impulse_Ns, std::uint8_t trigger, do
   return InputVerdict::Ok;
 }
 
-}  // namespace mft::services
+}  // namespace mft::chain

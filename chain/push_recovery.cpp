@@ -1,4 +1,4 @@
-#include "services/runtime/push_recovery.hpp"
+#include "chain/push_recovery.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-namespace mft::services {
+namespace mft::chain {
 namespace {
 
 // Fixed decimals (JSON has no NaN: null).
@@ -210,4 +210,4 @@ std::string RecoveryWindow::json(const RecoveryCriteria& criteria, bool fell, do
          ", \"tail\": " + r.tail.toJson() + ", \"criteria\": " + criteria.toJson() + ", \"verdict\": " + v.toJson() + "}";
 }
 
-}  // namespace mft::services
+}  // namespace mft::chain

@@ -9,9 +9,9 @@
 
 #include "model/robot_description.hpp"
 #include "planner/operator_command.hpp"
-#include "services/runtime/scenario.hpp"
+#include "chain/scenario.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
 // Throws config::ConfigError "<scenario file>: <key>: <value> is outside ... [lo, hi] ..." for the first
 // value out of range.
@@ -22,4 +22,4 @@ void checkScenarioLimits(const Scenario& scenario, const model::RobotDescription
 void checkScenarioLimits(const Scenario& scenario, const model::RobotDescription& robot,
                          const std::string& planner_yaml);
 
-}  // namespace mft::services
+}  // namespace mft::chain

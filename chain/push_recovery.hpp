@@ -16,7 +16,7 @@
 
 #include "model/robot_io.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
 enum class RecoveryRule { NoFall, BackToStepping };
 const char* toString(RecoveryRule r);
@@ -99,4 +99,4 @@ class RecoveryWindow {
   double after_min_z_, after_max_pitch_ = 0, after_max_speed_ = 0, after_min_lti_;
 };
 
-}  // namespace mft::services
+}  // namespace mft::chain

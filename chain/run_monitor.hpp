@@ -12,7 +12,7 @@
 
 #include "model/robot_io.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
 struct FallCriteria {
   double base_height_below_m = 0.25;
@@ -80,4 +80,4 @@ class RunMonitor {
   ErrorStats height_, pitch_;
 };
 
-}  // namespace mft::services
+}  // namespace mft::chain

@@ -1,4 +1,4 @@
-#include "services/runtime/scenario_limits.hpp"
+#include "chain/scenario_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include "model/mft_criteria.hpp"
 #include "planner/planner_config.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
 namespace {
 
@@ -70,4 +70,4 @@ void checkScenarioLimits(const Scenario& scenario, const model::RobotDescription
   checkScenarioLimits(scenario, robot, planner::commandLimits(robot, planner_config.command, planner_config.source_file));
 }
 
-}  // namespace mft::services
+}  // namespace mft::chain

@@ -6,12 +6,14 @@
 #include <string>
 #include <vector>
 
-#include "services/runtime/push_recovery.hpp"
+#include "chain/push_recovery.hpp"
+#include "planner/plan_output.hpp"
 
-namespace mft::services {
+namespace mft::chain {
 
-enum class LocomotionMode { Stand, StepInPlace, Walk };
-const char* toString(LocomotionMode m);
+// The project's one locomotion mode is the planner's (planner/plan_output.hpp); the IDL's LOCOMOTION_* octets
+// are converted at the DDS edge (mft-planner, the one reader of OperatorCommand).
+using planner::LocomotionMode;
 
 struct ScenarioCommand {
   double at_s = 0.0;
@@ -62,4 +64,4 @@ std::vector<std::string> activateRunProfiles(const std::string& config_dir, cons
 std::string profilesJson(const std::vector<std::string>& names);
 Scenario parseScenario(const std::string& yaml_text, const std::string& origin);
 
-}  // namespace mft::services
+}  // namespace mft::chain

@@ -1,0 +1,142 @@
+#pragma once
+// What mft-record subscribes to, one reader per topic: each DDS receive thread only copies the sample into the
+// recorder's queue and keeps the topic's count and newest tick. From those, the lockstep progress it publishes.
+// Not recorded: CommandVerdict (the stack's answer to mft-cmd). Its reason is text, which rawlog schema 1's
+// numeric channels cannot hold, and a new topic would change the schema that older recordings and tools share;
+// the commands themselves are recorded, and each verdict (with the tick a command was applied at) is in the
+// planner's and simulator's logs and summaries (docs/operator-commands.md).
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <type_traits>
+
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/DataReaderListener.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "services/record/record_participant.hpp"
+#include "services/record/recorder.hpp"
+#include "services/runtime/topic_names.hpp"
+
+namespace mft::services {
+
+template <class M, class = void>
+struct HasTick : std::false_type {};
+template <class M>
+struct HasTick<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
+
+// One topic into the recorder.
+template <class Msg, class PubSubType>
+class Subscription : public eprosima::fastdds::dds::DataReaderListener {
+ public:
+  Subscription(RecordParticipant& p, const std::string& topic_name, const std::string& profile, rawlog::Recorder& rec,
+               bool best_effort = false)
+      : subscriber_(p.subscriber()), recorder_(rec) {
+    namespace dds = eprosima::fastdds::dds;
+    dds::TypeSupport type(new PubSubType());
+    type.register_type(p.get());
+    topic_ = p.get()->create_topic(ddsTopicName(topic_name), type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+    if (!topic_) throw DdsError("cannot create the topic " + topic_name);
+    dds::DataReaderQos qos;
+    if (subscriber_->get_datareader_qos_from_profile(profile, qos) != eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      throw DdsError("no reader profile " + profile);
+    if (best_effort) qos.reliability().kind = dds::BEST_EFFORT_RELIABILITY_QOS;  // matches any writer, no acks
+    reader_ = subscriber_->create_datareader(topic_, qos, this);
+    if (!reader_) throw DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
+  }
+  ~Subscription() override { subscriber_->delete_datareader(reader_); }
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
+      if (info.valid_data) {
+        recorder_.push(rawlog::Message(sample_));
+        received_.fetch_add(1, std::memory_order_relaxed);
+        if constexpr (HasTick<Msg>::value)
+          if (sample_.tick() > last_tick_.load(std::memory_order_relaxed)) last_tick_.store(sample_.tick(), std::memory_order_relaxed);
+      }
+  }
+  std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
+  std::uint64_t lastTick() const { return last_tick_.load(std::memory_order_relaxed); }
+
+ private:
+  eprosima::fastdds::dds::Subscriber* subscriber_;
+  rawlog::Recorder& recorder_;
+  eprosima::fastdds::dds::Topic* topic_ = nullptr;
+  eprosima::fastdds::dds::DataReader* reader_ = nullptr;
+  Msg sample_;
+  std::atomic<std::uint64_t> received_{0};
+  std::atomic<std::uint64_t> last_tick_{0};
+};
+
+// Every recorded topic. The 1 kHz chain's readers use `chain_profile` (best effort with `best_effort`: the chain's
+// writers offer best effort in both modes, lockstep recovers a lost sample by re-sending the tick, and a reader
+// asking for more would not match; losses show as tick gaps, re-sent ticks as repeats).
+struct TopicTable {
+  TopicTable(RecordParticipant& p, rawlog::Recorder& r, const std::string& chain_profile, bool best_effort)
+      : truth(p, "GroundTruth", chain_profile, r, best_effort),
+        sensors(p, "SensorData", chain_profile, r, best_effort),
+        state(p, "RobotState", chain_profile, r, best_effort),
+        reference(p, "Reference", chain_profile, r, best_effort),
+        command(p, "JointCommand", chain_profile, r, best_effort),
+        diagnostics(p, "WbcDiagnostics", chain_profile, r, best_effort),
+        operator_command(p, "OperatorCommand", "event_reader", r),
+        disturbance(p, "Disturbance", "event_reader", r),
+        config_change(p, "ConfigChange", "event_reader", r) {}
+
+  // Every 1 kHz topic has delivered at least one sample.
+  bool flowing() const {
+    return truth.received() && sensors.received() && state.received() && reference.received() && command.received() &&
+           diagnostics.received();
+  }
+  // The newest tick seen on any 1 kHz topic (the socket is a FIFO: everything sent before it has been taken in, or
+  // was lost, and waiting for it would deadlock the run), and the newest tick seen on all of them.
+  std::uint64_t newestTick() const {
+    return std::max({truth.lastTick(), sensors.lastTick(), state.lastTick(), reference.lastTick(), command.lastTick(),
+                     diagnostics.lastTick()});
+  }
+  std::uint64_t allTopicsTick() const {
+    return std::min({truth.lastTick(), sensors.lastTick(), state.lastTick(), reference.lastTick(), command.lastTick(),
+                     diagnostics.lastTick()});
+  }
+  std::uint64_t chainReceived() const {
+    return truth.received() + sensors.received() + state.received() + reference.received() + command.received() +
+           diagnostics.received();
+  }
+
+  Subscription<msg::GroundTruth, msg::GroundTruthPubSubType> truth;
+  Subscription<msg::SensorData, msg::SensorDataPubSubType> sensors;
+  Subscription<msg::RobotState, msg::RobotStatePubSubType> state;
+  Subscription<msg::Reference, msg::ReferencePubSubType> reference;
+  Subscription<msg::JointCommand, msg::JointCommandPubSubType> command;
+  Subscription<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> diagnostics;
+  Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> operator_command;
+  Subscription<msg::Disturbance, msg::DisturbancePubSubType> disturbance;
+  // Live tuning: the requests and the changes the WBC and the planner applied, with their ticks (label config_change).
+  Subscription<msg::ConfigChange, msg::ConfigChangePubSubType> config_change;
+};
+
+// Lockstep: publishes how far the recorder has read its socket (the simulator waits when this falls more than its
+// --recorder-window behind), from the main loop every 5 ms, not per sample: no cost per tick. Nothing until every
+// 1 kHz topic flows: the simulator holds tick 0 until then, so that no writer's first samples go out before it has
+// matched the recorder (docs/dds.md#samples-before-matching). Unchanged progress is repeated every 50 ms.
+class ProgressReporter {
+ public:
+  void update(const TopicTable& topics, RecordParticipant& participant) {
+    if (!topics.flowing()) return;
+    const std::uint64_t tick = topics.newestTick(), all = topics.allTopicsTick();
+    if (tick == sent_ && all == all_sent_ && ++idle_loops_ < 10) return;
+    idle_loops_ = 0;
+    sent_ = tick;
+    all_sent_ = all;
+    participant.publishProgress(tick, all, topics.chainReceived());
+  }
+
+ private:
+  std::uint64_t sent_ = 0, all_sent_ = 0;
+  int idle_loops_ = 0;
+};
+
+}  // namespace mft::services

@@ -246,14 +246,16 @@ def build_parser():
                                    "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/tools/mft-experiment "
                                    "MFT_BIN_DIR=BIN dask-worker SCHEDULER --nthreads N. Each run takes a DDS domain "
                                    "that no other run on this machine holds (lock files in MFT_EXPERIMENT_SCRATCH, "
-                                   "default TMPDIR/mft-experiment-worker).")
+                                   "default TMPDIR/mft-experiment-worker).",
+                       epilog="Everything after -- goes to dask-worker as it is, e.g. "
+                              "mft-experiment worker tcp://head:8786 -- --host 10.0.0.2 --local-directory /scratch")
     w.add_argument("scheduler", metavar="SCHEDULER", help="the scheduler's address, tcp://HOST:8786")
+    w.set_defaults(dask_args=[])
     w.add_argument("--nthreads", type=int, default=max(1, os.cpu_count() or 1), metavar="N",
                    help="stacks at once on this machine (default: one per core, %(default)s)")
     w.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
     w.add_argument("--name", help="worker name shown in the client's per-worker counts (default: its address)")
     w.add_argument("--no-nanny", action="store_true", help="no nanny process (a killed worker is not restarted)")
-    w.add_argument("dask_args", nargs=argparse.REMAINDER, help="further dask-worker options after --")
     return p
 
 
@@ -281,7 +283,7 @@ def cmd_worker(args):
     env = dict(os.environ, MFT_BIN_DIR=str(Path(args.bin_dir).resolve()),
                PYTHONPATH=os.pathsep.join([tool_dir, str(REPO / "python")] +
                                           [p for p in [os.environ.get("PYTHONPATH")] if p]))
-    extra = [a for a in args.dask_args if a != "--"]
+    extra = list(args.dask_args)
     argv = [sys.executable, "-m", "distributed.cli.dask_worker", args.scheduler, "--nthreads", str(args.nthreads),
             "--no-dashboard"] + (["--name", args.name] if args.name else []) + (["--no-nanny"] if args.no_nanny else []) \
         + extra
@@ -341,7 +343,14 @@ def cmd_push_sweep(args):
 
 def main(argv=None):
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    dask_args = []
+    if argv[:1] == ["worker"] and "--" in argv:  # dask-worker's own options, passed on untouched
+        cut = argv.index("--")
+        argv, dask_args = argv[:cut], argv[cut + 1:]
     args = parser.parse_args(argv)
+    if args.command == "worker":
+        args.dask_args = dask_args
 
     def on_term(*_):
         raise KeyboardInterrupt()

@@ -173,6 +173,9 @@ def run_workers(worker, count, errors, interrupted_msg=None):
         e = errors[0]
         if isinstance(e, ExperimentError):
             raise e
+        if os.environ.get("MFT_EXPERIMENT_DEBUG"):
+            import traceback
+            traceback.print_exception(type(e), e, e.__traceback__)
         raise ExperimentError(f"a worker failed: {type(e).__name__}: {e}")
 
 

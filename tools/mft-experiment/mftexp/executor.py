@@ -267,6 +267,7 @@ class DaskExecutor:
         self.per_host = {}
         self.worker_wait_s = worker_wait_s
         self._futures = set()
+        self._closed_info = None
         try:
             self.client = self.distributed.Client(address, timeout=connect_timeout_s, set_as_default=False)
         except (OSError, TimeoutError) as e:
@@ -334,6 +335,8 @@ class DaskExecutor:
         return [DaskSlot(self, i) for i in range(self.in_flight)]
 
     def info(self):
+        if self._closed_info is not None:
+            return dict(self._closed_info)
         workers = self.client.scheduler_info()["workers"]
         return {"backend": "dask", "scheduler": self.address, "workers_now": len(workers),
                 "threads_now": sum(w.get("nthreads", 1) for w in workers.values()), "in_flight": self.in_flight,
@@ -346,6 +349,13 @@ class DaskExecutor:
             f.cancel()
 
     def close(self):
+        if self._closed_info is not None:
+            return
+        try:
+            self._closed_info = self.info()
+        except Exception:  # noqa: a scheduler already gone
+            self._closed_info = {"backend": "dask", "scheduler": self.address, "build": self.identity,
+                                 "hosts": dict(self.per_host)}
         try:
             self.client.close(timeout=10)
         except Exception:  # noqa: closing a client whose scheduler is gone

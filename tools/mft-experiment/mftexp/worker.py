@@ -139,6 +139,10 @@ def run_task(task):
         rawlog = record_path.read_bytes() if record_path else None
     except ExperimentError as e:
         raise RunFailed(f"{e} (on {socket.gethostname()}, kept in {run_dir})", name, log_tails(run_dir))
+    except Exception as e:  # noqa: a bug or a broken build on this machine: reported with its traceback
+        import traceback
+        raise RunFailed(f"{type(e).__name__}: {e} (on {socket.gethostname()}, kept in {run_dir})", name,
+                        traceback.format_exc() + "\n" + log_tails(run_dir))
     shutil.rmtree(run_dir, ignore_errors=True)
     return {"sim": sim, "wall": wall, "worker": name, "domain": domain, "host": socket.gethostname(),
             "rawlog": rawlog}

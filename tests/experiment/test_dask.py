@@ -116,16 +116,16 @@ class Cluster:
             raise
         return self
 
-    def start_worker(self, name, tool=TOOL, env=None):
+    def start_worker(self, name, tool=TOOL, env=None, bin_dir=BIN):
         self._spawn(name, name, [PY, str(tool), "worker", self.address, "--nthreads", "1", "--no-nanny", "--name", name,
-                                 "--bin-dir", str(BIN), "--", "--host", self.net.address(name),
+                                 "--bin-dir", str(bin_dir), "--", "--host", self.net.address(name),
                                  "--local-directory", str(self.tmp / f"dask-{name}")], env=env)
 
     def _spawn(self, name, host, argv, env=None):
-        logf = open(self.tmp / f"{name}.log", "w")
         e = dict(os.environ, MFT_EXPERIMENT_SCRATCH=str(self.scratch), **(env or {}))
-        self.procs[name] = subprocess.Popen(["ip", "netns", "exec", self.net.ns(host)] + argv, stdout=logf,
-                                            stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=e)
+        with open(self.tmp / f"{name}.log", "w") as logf:
+            self.procs[name] = subprocess.Popen(["ip", "netns", "exec", self.net.ns(host)] + argv, stdout=logf,
+                                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=e)
 
     def wait_log(self, name, text, timeout_s):
         deadline = time.monotonic() + timeout_s
@@ -250,6 +250,37 @@ class SweepOnDask(DaskTestBase):
         self.assertIn("config/ sha256", err)
         self.assertIn("commit", err)
         self.assertNotIn("Traceback", r.stderr)
+
+    def test_run_failing_everywhere_is_an_error_with_logs(self):
+        """A run that fails on every worker: tried on each, then one error line naming the run and its logs."""
+        broken = self.tmp / "broken-bin"
+        broken.mkdir()
+        for p in BIN.iterdir():
+            (broken / p.name).symlink_to(p)
+        (broken / "mft-wbc").unlink()
+        (broken / "mft-wbc").write_text("#!/bin/sh\necho 'mft-wbc: broken on purpose by the test' >&2\nexit 3\n")
+        (broken / "mft-wbc").chmod(0o755)
+        for w in ("w1", "w2"):
+            self.cluster.kill(w, signal.SIGTERM)
+            self.cluster.start_worker(w, bin_dir=broken)
+        for w in ("w1", "w2"):
+            self.cluster.wait_log(w, "Registered to", 60)
+        out = self.tmp / "failing"
+        t0 = time.monotonic()
+        r = self.cluster.client(*self.dask_args(out), "--no-rawlogs", timeout=300)
+        log(f"failing study: {time.monotonic() - t0:.1f} s, exit {r.returncode}")
+        self.assertEqual(r.returncode, 2, r.stderr[-3000:])
+        self.assertNotIn("Traceback", r.stderr)
+        err = r.stderr.strip().splitlines()[-1]
+        log(f"the error: {err}")
+        self.assertRegex(err, r"error: run runs/h0\.44-\w+-forward/6\.000 failed on w[12], w[12], w[12]: ", err)
+        self.assertIn("w1", err.split(":")[2])
+        self.assertIn("w2", err.split(":")[2])
+        logs = Path(err.rsplit("logs in ", 1)[1].rstrip(")"))
+        text = logs.read_text()
+        self.assertEqual(text.count("=== attempt"), 3, text[:2000])
+        self.assertIn("broken on purpose", text)
+        self.assertEqual([x for x in lines(out / "results.jsonl") if x["kind"] == "run"], [])
 
     def worker_logs(self):
         return "".join(f"\n--- {n}.log ---\n" + (self.tmp / f"{n}.log").read_text()[-1500:] for n in ("w1", "w2"))

@@ -28,9 +28,9 @@ REMOTE_ATTEMPTS = 3  # ... or on another worker where there is one (dask)
 class RunFailed(Exception):
     """A run that failed on a worker: the message, the worker and the tails of its logs."""
 
-    def __init__(self, message, worker="", logs=""):
-        super().__init__(message, worker, logs)
-        self.message, self.worker, self.logs = message, worker, logs
+    def __init__(self, message, worker="", logs="", address=""):
+        super().__init__(message, worker, logs, address)
+        self.message, self.worker, self.logs, self.address = message, worker, logs, address
 
     def __str__(self):
         return self.message
@@ -211,19 +211,24 @@ class DaskSlot:
         write_yaml_scenario(run_dir / "scenario.yaml", task["scenario"])  # what ran, beside the client's results
         full = dict(task, build=ex.identity, config=ex.config, domain_base=ex.domain_base,
                     domain_slots=ex.domain_slots, study=ex.study)
-        tried, failures = [], []
+        tried, failures, resubmits = [], [], 0
         while True:
             attempt = len(failures) + 1
-            untried = [w for w in ex.worker_addresses() if w not in tried]
-            fut = ex.client.submit(_run_on_worker, full, key=f"mft-run-{ex.study}-{task['name']}-a{attempt}",
-                                   pure=False, workers=untried or None, allow_other_workers=True)
+            # after a failure: only on workers that have not tried it, while there are such workers
+            untried = [w for w in ex.worker_addresses() if w not in tried] if failures else []
+            where = {"workers": untried, "allow_other_workers": False} if untried else {}
+            fut = ex.client.submit(_run_on_worker, full, key=f"mft-run-{ex.study}-{task['name']}-a{attempt}-{resubmits}",
+                                   pure=False, **where)
             try:
-                out = ex.wait(fut)
+                out = ex.wait(fut, restricted=untried)
+            except _RestrictedWorkersGone:
+                resubmits += 1
+                continue
             except BuildMismatch as e:
                 raise ExperimentError(str(e))
             except RunFailed as e:
                 failures.append(e)
-                tried.append(e.worker)
+                tried.append(e.address)
             except ex.distributed.KilledWorker as e:  # the scheduler gave up: its workers died running it
                 failures.append(RunFailed(f"the workers running it died ({e})", "killed", ""))
             else:
@@ -243,6 +248,10 @@ class DaskSlot:
                                       f"{failures[-1].message} (logs in {log_path})")
             log(f"run {task['name']} failed on {failures[-1].worker}: {failures[-1].message}; "
                 f"running it again elsewhere ({attempt} of {REMOTE_ATTEMPTS - 1})")
+
+
+class _RestrictedWorkersGone(Exception):
+    pass
 
 
 def _run_on_worker(task):
@@ -297,8 +306,9 @@ class DaskExecutor:
     def worker_addresses(self):
         return sorted(self.client.scheduler_info()["workers"])
 
-    def wait(self, fut):
-        """The future's result; Interrupted when stopping; an error when no worker was connected for too long."""
+    def wait(self, fut, restricted=None):
+        """The future's result; Interrupted when stopping; an error when no worker was connected for too long;
+        _RestrictedWorkersGone when the future may only run on `restricted` workers and all of those left."""
         with self.lock:
             self._futures.add(fut)
         no_worker_since = None
@@ -313,7 +323,11 @@ class DaskExecutor:
                     pass
                 except TimeoutError:
                     pass
-                if not self.client.scheduler_info()["workers"]:
+                connected = self.client.scheduler_info()["workers"]
+                if restricted and not set(restricted) & set(connected):
+                    fut.cancel()
+                    raise _RestrictedWorkersGone()
+                if not connected:
                     no_worker_since = no_worker_since or time.monotonic()
                     if time.monotonic() - no_worker_since > self.worker_wait_s:
                         fut.cancel()

@@ -43,6 +43,14 @@ def worker_name():
         return f"{socket.gethostname()}/{os.getpid()}"
 
 
+def worker_address():
+    try:
+        from distributed import get_worker
+        return get_worker().address
+    except (ImportError, ValueError):
+        return ""
+
+
 def probe(client_identity):
     """{"problem": None or one line, "host", "bin_dir"}: whether this worker can run the client's study."""
     problem = identity_difference(build_identity(), client_identity)
@@ -129,7 +137,7 @@ def run_task(task):
                          (("mft-closedloop",) if task["inprocess"] else ()))
         config_dir = materialize_config(task["config"])
     except ExperimentError as e:
-        raise RunFailed(f"{e} (on {socket.gethostname()})", name, "")
+        raise RunFailed(f"{e} (on {socket.gethostname()})", name, "", worker_address())
     safe = task["name"].replace("/", "_")
     run_dir = Path(tempfile.mkdtemp(prefix=f"{safe}.", dir=scratch_dir() / _study_dir(task["study"])))
     record_path = run_dir / "run.rawlog" if task["record"] else None
@@ -138,11 +146,12 @@ def run_task(task):
             sim, wall = execute(task, run_dir / "run", domain, bin_dir(), config_dir, record_path, attempts=1)
         rawlog = record_path.read_bytes() if record_path else None
     except ExperimentError as e:
-        raise RunFailed(f"{e} (on {socket.gethostname()}, kept in {run_dir})", name, log_tails(run_dir))
+        raise RunFailed(f"{e} (on {socket.gethostname()}, kept in {run_dir})", name, log_tails(run_dir),
+                        worker_address())
     except Exception as e:  # noqa: a bug or a broken build on this machine: reported with its traceback
         import traceback
         raise RunFailed(f"{type(e).__name__}: {e} (on {socket.gethostname()}, kept in {run_dir})", name,
-                        traceback.format_exc() + "\n" + log_tails(run_dir))
+                        traceback.format_exc() + "\n" + log_tails(run_dir), worker_address())
     shutil.rmtree(run_dir, ignore_errors=True)
     return {"sim": sim, "wall": wall, "worker": name, "domain": domain, "host": socket.gethostname(),
             "rawlog": rawlog}

@@ -245,6 +245,7 @@ class SweepOnDask(DaskTestBase):
         r = self.cluster.client(*self.dask_args(self.tmp / "refused"), timeout=300)
         self.assertEqual(r.returncode, 2, r.stderr[-2000:])
         err = r.stderr.strip().splitlines()[-1]
+        log(f"the refusal: {err}")
         self.assertIn("refuse", err)
         self.assertIn("its build differs", err)
         self.assertIn("config/ sha256", err)

@@ -280,7 +280,8 @@ def cmd_worker(args):
     if args.nthreads < 1:
         raise ExperimentError("--nthreads must be at least 1")
     tool_dir = str(Path(__file__).resolve().parent.parent)
-    env = dict(os.environ, MFT_BIN_DIR=str(Path(args.bin_dir).resolve()),
+    # No statistical profiler (it samples every thread each 10 ms, on cores the stacks need).
+    env = dict(os.environ, MFT_BIN_DIR=str(Path(args.bin_dir).resolve()), DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED="False",
                PYTHONPATH=os.pathsep.join([tool_dir, str(REPO / "python")] +
                                           [p for p in [os.environ.get("PYTHONPATH")] if p]))
     extra = list(args.dask_args)

@@ -122,10 +122,27 @@ def log_tails(run_dir, limit=4000):
     return "\n".join(out) or "(no log files)"
 
 
+# What a Dask nanny puts into its worker's environment for numpy (distributed.nanny.pre-spawn-environ): not
+# passed on to the stacks, which run with the environment of the user who started the worker.
+NANNY_ENVIRON = ("MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+
+
+def _drop_nanny_environ():
+    try:
+        import dask
+        spawned = dask.config.get("distributed.nanny.pre-spawn-environ", {}) or {}
+    except ImportError:
+        return
+    for k in NANNY_ENVIRON:
+        if k in spawned and os.environ.get(k) == str(spawned[k]):
+            os.environ.pop(k, None)
+
+
 def run_task(task):
     """One run of a study on this worker (see the module's doc). Returns {"sim", "wall", "worker", "domain",
     "host", "rawlog" (bytes or None)}."""
     name = worker_name()
+    _drop_nanny_environ()
     problem = identity_difference(build_identity(), task["build"])
     if problem:
         raise BuildMismatch(f"Dask worker {name} on {socket.gethostname()} refuses: its build differs from the "

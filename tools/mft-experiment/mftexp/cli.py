@@ -259,10 +259,14 @@ def build_parser():
     return p
 
 
-def check_distributed_args(args):
+def check_scheduler_address(text, what="--scheduler"):
     import re
-    if not re.fullmatch(r"(tcp|tls|inproc|ucx)://\S+", args.scheduler):
-        raise ExperimentError(f"--scheduler {args.scheduler!r}: expected an address like tcp://HOST:8786")
+    if not re.fullmatch(r"(tcp|tls|ucx)://\S+", text):
+        raise ExperimentError(f"{what} {text!r}: expected an address like tcp://HOST:8786")
+
+
+def check_distributed_args(args):
+    check_scheduler_address(args.scheduler)
     if args.in_flight is not None and not 1 <= args.in_flight <= 4096:
         raise ExperimentError("--in-flight must be 1..4096")
     if not 1 <= args.domain_slots or args.domain_base + args.domain_slots - 1 > 232:
@@ -276,6 +280,7 @@ def cmd_worker(args):
     if importlib.util.find_spec("distributed") is None:
         raise ExperimentError(f"Dask distributed is missing for {sys.executable} (Debian: apt-get install "
                               f"python3-distributed)")
+    check_scheduler_address(args.scheduler, "SCHEDULER")
     check_setup(args.bin_dir, DEFAULT_CONFIG)
     if args.nthreads < 1:
         raise ExperimentError("--nthreads must be at least 1")

@@ -338,7 +338,8 @@ def cmd_push_sweep(args):
                     "table_csv": str(Path(args.out) / "table.csv"), "plot": str(png)})
     (Path(args.out) / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     log(f"done in {fmt_duration(wall)} ({sweep.new_runs} new runs"
-        + (f"; per worker: {sweep.progress.workers_text()}" if sweep.progress.per_worker else "")
+        + (f"; runs per worker, recorded re-runs included: {sweep.progress.workers_text()}"
+           if sweep.progress.per_worker else "")
         + f"): {args.out}/table.md, table.csv, push_sweep.png")
     if args.json:
         print(json.dumps(summary, indent=1))

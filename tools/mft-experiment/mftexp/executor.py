@@ -89,9 +89,11 @@ def build_identity():
 
 def identity_difference(mine, theirs):
     """One line saying how two build identities differ, or None when they match."""
+    def short(commit):
+        return commit[:12] if all(c in "0123456789abcdef" for c in commit) else commit
     parts = []
     if mine["commit"] != theirs["commit"]:
-        parts.append(f"commit {mine['commit'][:12]} (client {theirs['commit'][:12]})")
+        parts.append(f"commit {short(mine['commit'])} (client {short(theirs['commit'])})")
     if mine["uncommitted"] != theirs["uncommitted"]:
         parts.append(f"uncommitted changes {mine['uncommitted'] or 'none'} (client {theirs['uncommitted'] or 'none'})")
     if mine["config_sha256"] != theirs["config_sha256"]:

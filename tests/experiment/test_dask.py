@@ -75,6 +75,17 @@ def processes_mentioning(text):
     return found
 
 
+def _die_with_test():
+    # Runs in the child before exec: SIGKILL when this test process dies (CTest's timeout kills it with
+    # SIGKILL), so no scheduler or worker outlives it in a namespace that a later test deletes as stale (a
+    # dask-worker whose scheduler is gone does not end on SIGTERM); a worker's stacks die with it in turn.
+    import ctypes
+    try:
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except OSError:
+        pass
+
+
 def children(pid):
     """[(pid, command line)] of the children of pid."""
     out = []
@@ -125,7 +136,8 @@ class Cluster:
         e = dict(os.environ, MFT_EXPERIMENT_SCRATCH=str(self.scratch), **(env or {}))
         with open(self.tmp / f"{name}.log", "w") as logf:
             self.procs[name] = subprocess.Popen(["ip", "netns", "exec", self.net.ns(host)] + argv, stdout=logf,
-                                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=e)
+                                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=e,
+                                                preexec_fn=_die_with_test)
 
     def wait_log(self, name, text, timeout_s):
         deadline = time.monotonic() + timeout_s
@@ -139,8 +151,9 @@ class Cluster:
     def client(self, *args, wait=True, timeout=900):
         argv = ["ip", "netns", "exec", self.net.ns("head"), PY, str(TOOL)] + [str(a) for a in args]
         if not wait:
-            return subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        return subprocess.run(argv, capture_output=True, text=True, timeout=timeout)
+            return subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                    preexec_fn=_die_with_test)
+        return subprocess.run(argv, capture_output=True, text=True, timeout=timeout, preexec_fn=_die_with_test)
 
     def kill(self, name, sig=signal.SIGKILL):
         p = self.procs.get(name)

@@ -279,6 +279,8 @@ class DaskExecutor:
         self.worker_wait_s = worker_wait_s
         self._futures = set()
         self._closed_info = None
+        self._info_lock = threading.Lock()
+        self._workers_cache = None
         try:
             self.client = self.distributed.Client(address, timeout=connect_timeout_s, set_as_default=False)
         except (OSError, TimeoutError) as e:
@@ -286,12 +288,11 @@ class DaskExecutor:
                                   f"start one with dask-scheduler (docs/experiments.md#several-machines)")
         try:
             self.client.wait_for_workers(1, timeout=worker_wait_s)
-        except (TimeoutError, self.distributed.TimeoutError if hasattr(self.distributed, "TimeoutError") else
-                TimeoutError):
+        except (TimeoutError, self.distributed.TimeoutError, OSError):
             self.close()
             raise ExperimentError(f"no Dask worker joined {address} within {worker_wait_s:.0f} s")
         self.check_workers()
-        threads = sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values())
+        threads = sum(w.get("nthreads", 1) for w in self.workers_info().values())
         self.in_flight = in_flight or max(2, threads)
 
     def check_workers(self):
@@ -305,8 +306,17 @@ class DaskExecutor:
         if bad:
             raise ExperimentError("Dask worker(s) refuse this study: " + " | ".join(bad))
 
+    def workers_info(self, max_age_s=1.0):
+        """{address: info} of the connected workers. One search thread at a time asks the scheduler, at most
+        every max_age_s (Client.scheduler_info updates shared state of the client)."""
+        with self._info_lock:
+            now = time.monotonic()
+            if self._workers_cache is None or now - self._workers_cache[0] > max_age_s:
+                self._workers_cache = (now, dict(self.client.scheduler_info()["workers"]))
+            return self._workers_cache[1]
+
     def worker_addresses(self):
-        return sorted(self.client.scheduler_info()["workers"])
+        return sorted(self.workers_info())
 
     def wait(self, fut, restricted=None):
         """The future's result; Interrupted when stopping; an error when no worker was connected for too long;
@@ -321,11 +331,9 @@ class DaskExecutor:
                     raise Interrupted()
                 try:
                     return fut.result(timeout=0.5)
-                except self.distributed.TimeoutError:
+                except (TimeoutError, self.distributed.TimeoutError):  # one class from Python 3.11 on
                     pass
-                except TimeoutError:
-                    pass
-                connected = self.client.scheduler_info()["workers"]
+                connected = self.workers_info()
                 if restricted and not set(restricted) & set(connected):
                     fut.cancel()
                     raise _RestrictedWorkersGone()
@@ -342,7 +350,7 @@ class DaskExecutor:
                 self._futures.discard(fut)
 
     def describe(self):
-        workers = self.client.scheduler_info()["workers"]
+        workers = self.workers_info()
         threads = sum(w.get("nthreads", 1) for w in workers.values())
         return (f"Dask scheduler {self.address}: {len(workers)} workers, {threads} threads, {self.in_flight} runs in "
                 f"flight, build {self.identity['commit'][:12]}")
@@ -353,7 +361,7 @@ class DaskExecutor:
     def info(self):
         if self._closed_info is not None:
             return dict(self._closed_info)
-        workers = self.client.scheduler_info()["workers"]
+        workers = self.workers_info()
         return {"backend": "dask", "scheduler": self.address, "workers_now": len(workers),
                 "threads_now": sum(w.get("nthreads", 1) for w in workers.values()), "in_flight": self.in_flight,
                 "build": self.identity, "hosts": dict(self.per_host)}

@@ -10,7 +10,7 @@ PACKAGES=(
   cyclonedds-dev cyclonedds-tools
   libmrpt-obs-dev libmrpt-io-dev mrpt-apps
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3 python3-yaml python3-matplotlib
+  python3 python3-yaml python3-matplotlib python3-distributed
   ffmpeg
   iproute2 nftables
   openssl

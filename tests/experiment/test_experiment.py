@@ -196,6 +196,9 @@ class ExperimentTest(unittest.TestCase):
             (["push-sweep", "--heights", HEIGHT, "--step", "0.5", "--out", str(self.full), "--bin-dir", str(BIN)],
              "other settings"),
             (["bogus"], "invalid choice"),
+            (["push-sweep", "--scheduler", "localhost", "--bin-dir", str(BIN)], "expected an address"),
+            (["worker", "8786"], "expected an address"),
+            (["worker", "tcp://127.0.0.1:8786", "--bin-dir", str(self.tmp / "nope")], "does not exist"),
         ]
         changed = self.tmp / "config-changed"  # resuming after a configuration change is refused
         shutil.copytree(REPO / "config", changed)

@@ -100,20 +100,21 @@ def cmd_ablation(args, setup):
     def stepping_job(variant, controller):
         key = f"{variant.name}/{controller}"
 
-        def job(domain):
+        def job(slot):
             if key in sweep.results.extra.get("stepping", {}):
                 return
             rd = sweep.out / "runs" / "stepping" / f"{variant.name}-{controller}"
-            sim, wall = sweep.run_push(variant, args.sensitivity_height, controller, None, rd, domain)
+            r = sweep.run_push(variant, args.sensitivity_height, controller, None, rd, slot)
+            sim, wall = r.sim, r.wall
             tail = sim["recovery"]["tail"]
             sweep.results.add_extra({"kind": "stepping", "key": key, "variant": variant.name, "controller": controller,
                                      "height_cmd_m": args.sensitivity_height, "fell": sim.get("fell"),
                                      "mean_base_height_m": tail["mean_base_height_m"] if tail else None,
                                      "mean_speed_mps": tail["mean_speed_mps"] if tail else None,
-                                     "wall_s": round(wall, 2)})
+                                     "wall_s": round(wall, 2), "worker": r.worker})
             sweep.progress.run_finished(wall, f"stepping {variant.name} {controller}: base at "
                                               f"{tail['mean_base_height_m']:.4f} m" if tail else "no data",
-                                        sweep.remaining_runs())
+                                        sweep.remaining_runs(), worker=r.worker)
         return job
 
     jobs = [stepping_job(v, c) for v in [variants[0]] + sens_variants for c in args.controllers]
@@ -121,12 +122,14 @@ def cmd_ablation(args, setup):
     load0 = load_text()
     log(f"ablation into {args.out}: {len(variants)} variants x heights {args.heights} + {len(sens_variants)} values of "
         f"{args.param} at {args.sensitivity_height} m, controllers {args.controllers}, search {args.search}, "
-        + ("in process" if args.inprocess else f"{args.workers} stacks") + f"; load average {load0}")
+        + ("in process, " if args.inprocess else "") + sweep.executor.describe() + f"; load average {load0}")
     wall = None
     try:
         wall = sweep.run(jobs)
     finally:
+        sweep.executor.close()
         report = write_report(args, sweep, variants, sens_variants, sens, wall, (load0, load_text()))
+    report.update({"progress": sweep.progress.snapshot(), "executor": sweep.executor.info()})
     png = plot(args, report)
     report["plot"] = str(png)
     (Path(args.out) / "ablation.json").write_text(json.dumps(report, indent=1) + "\n")

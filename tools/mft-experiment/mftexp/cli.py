@@ -1,6 +1,7 @@
 """Command line of mft-experiment."""
 import argparse
 import json
+import os
 import signal
 import sys
 import time
@@ -19,6 +20,7 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
               and a side-by-side video (terrain.mp4)
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
+  worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/experiments.md)
 
 Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
 keeps what finished (exit status 130) and stops every stack this tool started."""
@@ -97,6 +99,21 @@ def add_common(p, workers=True):
     p.add_argument("--quiet", action="store_true", help="no progress lines")
 
 
+def add_distributed(p):
+    g = p.add_argument_group("several machines (Dask distributed; docs/experiments.md#several-machines)")
+    g.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run every stack run as a task on the workers of this Dask scheduler (tcp://HOST:8786) "
+                        "instead of --workers stacks here; results.jsonl, the table and resuming are the same")
+    g.add_argument("--in-flight", type=int, metavar="N",
+                   help="with --scheduler: searches (one run each) in flight at once (default: the workers' threads "
+                        "when the study starts)")
+    g.add_argument("--domain-slots", type=int, default=10, metavar="N",
+                   help="with --scheduler: a worker machine runs its stacks on domains domain-base .. domain-base+N-1, "
+                        "each held by one run at a time (default %(default)s)")
+    g.add_argument("--worker-wait", type=positive, default=120.0, metavar="S",
+                   help="with --scheduler: give up when no worker is connected for this long [s] (default 120)")
+
+
 def add_push_setup(p):
     g = p.add_argument_group("push and recovery criteria")
     g.add_argument("--direction", choices=("forward", "backward"), default="forward", help="push direction (default forward)")
@@ -150,7 +167,7 @@ def make_setup(args):
 def build_parser():
     p = Parser(prog="mft-experiment", description=DESCRIPTION,
                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,ablation}", parser_class=Parser)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,ablation,worker}", parser_class=Parser)
     sub.required = True
 
     s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
@@ -168,6 +185,7 @@ def build_parser():
     s.add_argument("--out", help="output folder; an existing one is resumed (default runs/experiment-<time>)")
     add_push_setup(s)
     add_common(s)
+    add_distributed(s)
 
     c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
                        description="One push at one height with both controllers (recorded), and the paper's "
@@ -220,10 +238,68 @@ def build_parser():
     a.add_argument("--out", help="output folder; an existing one is resumed (default runs/ablation-<time>)")
     add_push_setup(a)
     add_common(a)
+    add_distributed(a)
+
+    w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/experiments.md)",
+                       description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "
+                                   "its services (--bin-dir) as the binaries of every run; runs until stopped "
+                                   "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/tools/mft-experiment "
+                                   "MFT_BIN_DIR=BIN dask-worker SCHEDULER --nthreads N. Each run takes a DDS domain "
+                                   "that no other run on this machine holds (lock files in MFT_EXPERIMENT_SCRATCH, "
+                                   "default TMPDIR/mft-experiment-worker).",
+                       epilog="Everything after -- goes to dask-worker as it is, e.g. "
+                              "mft-experiment worker tcp://head:8786 -- --host 10.0.0.2 --local-directory /scratch")
+    w.add_argument("scheduler", metavar="SCHEDULER", help="the scheduler's address, tcp://HOST:8786")
+    w.set_defaults(dask_args=[])
+    w.add_argument("--nthreads", type=int, default=max(1, os.cpu_count() or 1), metavar="N",
+                   help="stacks at once on this machine (default: one per core, %(default)s)")
+    w.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
+    w.add_argument("--name", help="worker name shown in the client's per-worker counts (default: its address)")
+    w.add_argument("--no-nanny", action="store_true", help="no nanny process (a killed worker is not restarted)")
     return p
 
 
+def check_scheduler_address(text, what="--scheduler"):
+    import re
+    if not re.fullmatch(r"(tcp|tls|ucx)://\S+", text):
+        raise ExperimentError(f"{what} {text!r}: expected an address like tcp://HOST:8786")
+
+
+def check_distributed_args(args):
+    check_scheduler_address(args.scheduler)
+    if args.in_flight is not None and not 1 <= args.in_flight <= 4096:
+        raise ExperimentError("--in-flight must be 1..4096")
+    if not 1 <= args.domain_slots or args.domain_base + args.domain_slots - 1 > 232:
+        raise ExperimentError(f"--domain-base {args.domain_base} with --domain-slots {args.domain_slots} leaves the "
+                              f"DDS domains 0..232")
+
+
+def cmd_worker(args):
+    """execs dask-worker with this clone's mftexp importable and its build as the binaries."""
+    import importlib.util
+    if importlib.util.find_spec("distributed") is None:
+        raise ExperimentError(f"Dask distributed is missing for {sys.executable} (Debian: apt-get install "
+                              f"python3-distributed)")
+    check_scheduler_address(args.scheduler, "SCHEDULER")
+    check_setup(args.bin_dir, DEFAULT_CONFIG)
+    if args.nthreads < 1:
+        raise ExperimentError("--nthreads must be at least 1")
+    tool_dir = str(Path(__file__).resolve().parent.parent)
+    # No statistical profiler (it samples every thread each 10 ms, on cores the stacks need).
+    env = dict(os.environ, MFT_BIN_DIR=str(Path(args.bin_dir).resolve()), DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED="False",
+               PYTHONPATH=os.pathsep.join([tool_dir, str(REPO / "python")] +
+                                          [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    extra = list(args.dask_args)
+    argv = [sys.executable, "-m", "distributed.cli.dask_worker", args.scheduler, "--nthreads", str(args.nthreads),
+            "--no-dashboard"] + (["--name", args.name] if args.name else []) + (["--no-nanny"] if args.no_nanny else []) \
+        + extra
+    log(f"dask-worker for {args.scheduler}: {args.nthreads} threads, binaries {env['MFT_BIN_DIR']}")
+    os.execve(sys.executable, argv, env)
+
+
 def use_snapshot(args):
+    if getattr(args, "scheduler", None):
+        return  # the workers use their own builds (checked against this clone's commit)
     if args.snapshot:
         Path(args.out).mkdir(parents=True, exist_ok=True)
         args.bin_dir = str(snapshot_binaries(args.bin_dir, Path(args.out) / "bin"))
@@ -246,21 +322,25 @@ def cmd_push_sweep(args):
     load0 = load_text()
     log(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
         f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), "
-        + ("in process" if args.inprocess else f"{args.workers} stacks on domains {args.domain_base}.."
-                                                f"{args.domain_base + args.workers - 1}") + f"; load average {load0}")
+        + ("in process, " if args.inprocess else "") + sweep.executor.describe() + f"; load average {load0}")
     wall = None
     try:
         wall = sweep.run()
     finally:
+        sweep.executor.close()
         table = report.write_tables(args.out, sweep.results, args.heights, args.controllers, args.direction,
                                     sweep.grid, dict(asdict(setup), profiles=sweep.variants["default"].profiles),
                                     wall, (load0, load_text()))
     png = report.plot_sweep(args.out, table, args.direction)
     summary = report.summary_json(table, sweep.results, sweep.grid, asdict(setup), wall, sweep.new_runs)
-    summary.update({"load_average": [load0, load_text()], "out": args.out, "table_md": str(Path(args.out) / "table.md"),
+    summary.update({"progress": sweep.progress.snapshot(), "executor": sweep.executor.info(),
+                    "load_average": [load0, load_text()], "out": args.out, "table_md": str(Path(args.out) / "table.md"),
                     "table_csv": str(Path(args.out) / "table.csv"), "plot": str(png)})
     (Path(args.out) / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
-    log(f"done in {fmt_duration(wall)} ({sweep.new_runs} new runs): {args.out}/table.md, table.csv, push_sweep.png")
+    log(f"done in {fmt_duration(wall)} ({sweep.new_runs} new runs"
+        + (f"; runs per worker, recorded re-runs included: {sweep.progress.workers_text()}"
+           if sweep.progress.per_worker else "")
+        + f"): {args.out}/table.md, table.csv, push_sweep.png")
     if args.json:
         print(json.dumps(summary, indent=1))
     else:
@@ -270,19 +350,34 @@ def cmd_push_sweep(args):
 
 def main(argv=None):
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    dask_args = []
+    if argv[:1] == ["worker"] and "--" in argv:  # dask-worker's own options, passed on untouched
+        cut = argv.index("--")
+        argv, dask_args = argv[:cut], argv[cut + 1:]
     args = parser.parse_args(argv)
+    if args.command == "worker":
+        args.dask_args = dask_args
 
     def on_term(*_):
         raise KeyboardInterrupt()
     signal.signal(signal.SIGTERM, on_term)
     try:
-        if args.domain_base + getattr(args, "workers", 2) - 1 > 232:
+        if args.command == "worker":
+            return cmd_worker(args)
+        if getattr(args, "scheduler", None):
+            check_distributed_args(args)
+        elif args.domain_base + getattr(args, "workers", 2) - 1 > 232:
             raise ExperimentError(f"--domain-base {args.domain_base} leaves no DDS domain (0..232) for every stack")
-        check_setup(args.bin_dir, args.config_dir,
-                    need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
-                         (("mft-record", "mft-export") if args.command in ("case", "terrain") or
-                          getattr(args, "keep_rawlogs", False) else ()) +
-                         (("mft-closedloop",) if getattr(args, "inprocess", False) else ()))
+        if getattr(args, "scheduler", None):  # the stacks run on the workers, with their own builds
+            if not (Path(args.config_dir) / "robot.yaml").is_file():
+                raise ExperimentError(f"configuration folder {args.config_dir} has no robot.yaml")
+        else:
+            check_setup(args.bin_dir, args.config_dir,
+                        need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
+                             (("mft-record", "mft-export") if args.command in ("case", "terrain") or
+                              getattr(args, "keep_rawlogs", False) else ()) +
+                             (("mft-closedloop",) if getattr(args, "inprocess", False) else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
         if args.command in ("case", "terrain"):

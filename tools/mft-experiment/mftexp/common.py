@@ -173,6 +173,9 @@ def run_workers(worker, count, errors, interrupted_msg=None):
         e = errors[0]
         if isinstance(e, ExperimentError):
             raise e
+        if os.environ.get("MFT_EXPERIMENT_DEBUG"):
+            import traceback
+            traceback.print_exception(type(e), e, e.__traceback__)
         raise ExperimentError(f"a worker failed: {type(e).__name__}: {e}")
 
 
@@ -331,25 +334,60 @@ def read_csv(path):
 
 
 class Progress:
-    """Progress lines with an estimate of the time left, on stderr."""
+    """Progress on stderr: runs done of the estimated total, runs per minute, the time left and how many runs
+    each worker (a local domain or a Dask worker) did; snapshot() gives the same figures for --json."""
 
-    def __init__(self, workers, quiet=False):
+    def __init__(self, workers, quiet=False, every_s=60.0):
         self.workers = max(1, workers)
         self.quiet = quiet
         self.lock = threading.Lock()
         self.t0 = time.monotonic()
         self.walls = []
         self.runs_done = 0
+        self.remaining = None
+        self.per_worker = {}
+        self.every_s = every_s  # a per-worker line at most this often
+        self._last_workers_line = self.t0
 
-    def run_finished(self, wall_s, text, remaining_runs):
+    def _rate_and_eta(self, remaining):
+        elapsed = time.monotonic() - self.t0
+        rate = self.runs_done / (elapsed / 60.0) if elapsed > 0 and self.runs_done else None
+        if rate and self.runs_done >= self.workers:  # the observed pace, once every worker finished about one run
+            eta = remaining / rate * 60.0
+        else:
+            eta = remaining * (sum(self.walls) / len(self.walls)) / self.workers if self.walls else None
+        return elapsed, rate, eta
+
+    def run_finished(self, wall_s, text, remaining_runs, worker=None):
         with self.lock:
             self.walls.append(wall_s)
             self.runs_done += 1
-            mean = sum(self.walls) / len(self.walls)
-            eta = remaining_runs * mean / self.workers
+            self.remaining = remaining_runs
+            if worker:
+                self.per_worker[worker] = self.per_worker.get(worker, 0) + 1
+            elapsed, rate, eta = self._rate_and_eta(remaining_runs)
             if not self.quiet:
-                print(f"[{fmt_duration(time.monotonic() - self.t0)} elapsed, ~{fmt_duration(eta)} left, "
-                      f"{self.runs_done} runs] {text}", file=sys.stderr, flush=True)
+                total = self.runs_done + int(round(remaining_runs))
+                print(f"[{fmt_duration(elapsed)} elapsed, ~{fmt_duration(eta or 0)} left, {self.runs_done}/~{total} runs, "
+                      f"{rate or 0:.1f} runs/min] {text}", file=sys.stderr, flush=True)
+                now = time.monotonic()
+                if len(self.per_worker) > 1 and now - self._last_workers_line >= self.every_s:
+                    self._last_workers_line = now
+                    print(f"[{fmt_duration(elapsed)}] runs per worker: {self.workers_text()}", file=sys.stderr,
+                          flush=True)
+
+    def workers_text(self):
+        return ", ".join(f"{w} {n}" for w, n in sorted(self.per_worker.items()))
+
+    def snapshot(self):
+        """{"runs_done", "runs_total_estimate", "runs_per_min", "eta_s", "elapsed_s", "per_worker"}."""
+        with self.lock:
+            remaining = self.remaining or 0.0
+            elapsed, rate, eta = self._rate_and_eta(remaining)
+            return {"runs_done": self.runs_done, "runs_total_estimate": self.runs_done + int(round(remaining)),
+                    "runs_per_min": None if rate is None else round(rate, 2),
+                    "eta_s": None if eta is None else round(eta, 1), "elapsed_s": round(elapsed, 1),
+                    "per_worker": dict(sorted(self.per_worker.items()))}
 
     def note(self, text):
         if not self.quiet:

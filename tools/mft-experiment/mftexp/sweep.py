@@ -23,9 +23,9 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .common import (ExperimentError, Interrupted, Progress, REGISTRY, check_scenario, log, run_closedloop,
-                     run_scenario, run_workers)
+from .common import ExperimentError, Interrupted, Progress, REGISTRY, log, run_workers
 from . import push as pushmod
+from .executor import make_executor, run_task
 
 
 def config_hash(config_dir):
@@ -231,7 +231,7 @@ class Sweep:
     """Cells (variant, height, controller, direction), each searched for I_max; on the stack (default) or in
     process (mft-closedloop). push-sweep has one variant; ablation and sensitivity have several."""
 
-    def __init__(self, args, setup, variants=None, kind="sweep", config_dir=None, cells=None):
+    def __init__(self, args, setup, variants=None, kind="sweep", config_dir=None, cells=None, executor=None):
         self.args = args
         self.setup = setup
         self.kind = kind
@@ -254,7 +254,9 @@ class Sweep:
         self.above_k = max(0, int(round(self.grid["above_Ns"] / args.step)))
         self.cells = cells or [(v, h, c, setup.direction) for v in self.variants for h in args.heights
                                for c in args.controllers]
-        self.progress = Progress(args.workers, quiet=args.quiet)
+        # where the runs happen: stacks on this machine (default) or Dask workers (--scheduler); mftexp.executor
+        self.executor = executor or make_executor(args, self.config_dir)
+        self.progress = Progress(len(self.executor.slots()), quiet=args.quiet)
         self.lock = threading.Lock()
         self.cell_runs = {c: 0 for c in self.cells}
         for k in self.results.runs:
@@ -295,39 +297,23 @@ class Sweep:
         s.profiles = list(variant.profiles)
         return s
 
-    def run_push(self, variant, height, controller, impulse, rd, domain, record=None):
-        """One run (impulse None: stepping only, no push). Returns (mft-sim-like summary, wall)."""
-        rd.mkdir(parents=True, exist_ok=True)
-        scen = rd / "scenario.yaml"
+    def run_push(self, variant, height, controller, impulse, rd, slot, record=None, name=None):
+        """One run (impulse None: stepping only, no push) on `slot` (mftexp.executor). Returns a RunResult."""
         setup = self.setup_for(variant)
         s = pushmod.scenario(setup, height, controller, impulse or 0.0)
         if impulse is None:
             s.pop("pushes")
-        from .common import write_yaml_scenario
-        write_yaml_scenario(scen, s)
-        if variant.name not in self.checked:
-            check_scenario(self.args.bin_dir, self.config_dir, scen, profiles=variant.profiles)
-            self.checked.add(variant.name)
-        if self.inprocess and not record:
-            return run_closedloop(scen, self.args.bin_dir, self.config_dir, timeout_s=setup.duration_s * 60 + 60,
-                                  profiles=variant.profiles)
-        for attempt in (1, 2, 3):
-            try:
-                summary, wall = run_scenario(scen, rd, domain, self.args.bin_dir, self.config_dir, record=record,
-                                             timeout_s=setup.duration_s * 30 + 120, profiles=variant.profiles)
-                sim = dict(summary["services"]["mft-sim"])
-                sim.setdefault("profiles", summary.get("profiles"))  # what the stack reports it ran with
-                return sim, wall
-            except ExperimentError as e:
-                if attempt == 3 or REGISTRY.stopping.is_set():
-                    raise
-                log(f"{e}; retrying ({attempt} of 2)")
-                time.sleep(3.0 * attempt)
+        inprocess = self.inprocess and not record
+        task = run_task(name or str(rd.relative_to(self.out)), s, variant.profiles,
+                        timeout_s=setup.duration_s * (60 if inprocess else 30) + (60 if inprocess else 120),
+                        inprocess=inprocess, record=bool(record))
+        return slot.run(task, rd, record)
 
-    def run_one(self, cell, impulse, domain, record=None):
+    def run_one(self, cell, impulse, slot, record=None):
         v, h, c, direction = cell
         rd = self.run_dir(cell, impulse, "-rec" if record else "")
-        sim, wall = self.run_push(self.variants[v], h, c, impulse, rd, domain, record)
+        r = self.run_push(self.variants[v], h, c, impulse, rd, slot, record)
+        sim, wall, domain = r.sim, r.wall, r.domain
         recovered, reason = pushmod.judge(sim)
         if recovered is None:
             raise ExperimentError(f"{cell_name(cell)} I={impulse}: {reason} (logs in {rd})")
@@ -339,30 +325,32 @@ class Sweep:
                 "fall_time_s": sim.get("fall_time_s"), "push_time_s": rec.get("push_time_s"),
                 "pre": rec.get("pre"), "after": rec.get("after"), "tail": rec.get("tail"),
                 "sim_time_s": sim.get("sim_time_s"), "wall_s": round(wall, 3), "domain": domain,
+                "worker": r.worker, **({"host": r.host} if r.host else {}),
                 "runner": "inprocess" if self.inprocess and not record else "stack",
                 "profiles": self.variants[v].profiles, "applied_profiles": sim.get("profiles"), "run_dir": str(rd), "signature": pushmod.signature(sim),
                 "setup_key": self.setup.key(), "finished_at": time.strftime("%H:%M:%S")}, wall
 
-    def recovered(self, cell, k, domain):
+    def recovered(self, cell, k, slot):
         imp = self.impulse(k)
         key = cell + (ikey(imp),)
         d = self.results.runs.get(key)
         if d is None:
-            d, wall = self.run_one(cell, imp, domain)
+            d, wall = self.run_one(cell, imp, slot)
             d = dict({"kind": "run"}, **d)
             self.results.add_run(d)
             with self.lock:
                 self.cell_runs[cell] += 1
                 self.new_runs += 1
+            where = d["worker"] if self.executor.kind != "local" else ("" if self.inprocess else f"domain {d['domain']}")
             self.progress.run_finished(
                 wall, f"{cell_name(cell)} I = {imp:.2f} N s: {'recovered' if d['recovered'] else d['reason']} "
-                      f"({wall:.1f} s{'' if self.inprocess else f', domain {domain}'})", self.remaining_runs())
+                      f"({wall:.1f} s{', ' + where if where else ''})", self.remaining_runs(), worker=d["worker"])
         return d["recovered"]
 
     # ---------------------------------------------------------------------------------------------- search
-    def search_cell(self, cell, domain):
+    def search_cell(self, cell, slot):
         t0 = time.monotonic()
-        lo, hi, info = find_imax(lambda k: self.recovered(cell, k, domain), self.kmax, self.args.search,
+        lo, hi, info = find_imax(lambda k: self.recovered(cell, k, slot), self.kmax, self.args.search,
                                  self.coarse_k, self.above_k)
         above = [self.impulse(k) for k, ok in info.pop("above", []) if ok]
         for key in ("checks", "non_monotone_scan"):
@@ -397,7 +385,7 @@ class Sweep:
                     deterministic = deterministic and prev["identical"]
                     continue
                 path.parent.mkdir(parents=True, exist_ok=True)
-                d, wall = self.run_one(cell, imp, domain, record=path)
+                d, wall = self.run_one(cell, imp, slot, record=path)
                 first_run = self.results.runs[cell + (ikey(imp),)]
                 same = d["signature"] == first_run["signature"] or first_run.get("runner") == "inprocess" and \
                     d["recovered"] == first_run["recovered"]
@@ -409,7 +397,8 @@ class Sweep:
                 with self.lock:
                     self.cell_runs[cell] += 1
                 self.progress.run_finished(wall, f"{cell_name(cell)} I = {imp:.2f} N s recorded to {path.name}: "
-                                                 f"{'identical' if same else 'DIFFERENT'} outcome", self.remaining_runs())
+                                                 f"{'identical' if same else 'DIFFERENT'} outcome", self.remaining_runs(),
+                                           worker=d["worker"])
                 rawlogs[label] = str(path)
                 if not same:
                     log(f"{cell_name(cell)} I = {imp:.2f}: the recorded run differs from the first run "
@@ -428,7 +417,7 @@ class Sweep:
 
     # ------------------------------------------------------------------------------------------------- all
     def run(self, extra_jobs=()):
-        """Searches every cell not on file; `extra_jobs` are callables job(domain) run by the same workers."""
+        """Searches every cell not on file; `extra_jobs` are callables job(slot) run by the same slots."""
         todo = [c for c in self.cells if c not in self.results.cells]
         if self.results.resumed:
             log(f"resuming {self.out / 'results.jsonl'}: {len(self.cells) - len(todo)} of {len(self.cells)} cells "
@@ -439,8 +428,10 @@ class Sweep:
         qlock = threading.Lock()
         errors = []
 
+        slots = self.executor.slots()
+
         def worker(i):
-            domain = self.args.domain_base + i
+            slot = slots[i]
             while not REGISTRY.stopping.is_set():
                 with qlock:
                     if not queue:
@@ -448,9 +439,9 @@ class Sweep:
                     kind, item = queue.pop(0)
                 try:
                     if kind == "cell":
-                        self.search_cell(item, domain)
+                        self.search_cell(item, slot)
                     else:
-                        item(domain)
+                        item(slot)
                         with self.lock:
                             self.extra_remaining -= 1
                 except Interrupted:
@@ -458,9 +449,10 @@ class Sweep:
                 except BaseException as e:  # noqa: the main thread reports it
                     errors.append(e)
                     REGISTRY.stop_all()
+                    self.executor.cancel()
                     return
 
         t0 = time.monotonic()
-        run_workers(worker, self.args.workers, errors,
+        run_workers(worker, len(slots), errors,
                     "interrupted: stopping the runs in flight (finished runs are kept in results.jsonl)")
         return time.monotonic() - t0

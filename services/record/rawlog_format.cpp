@@ -8,7 +8,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "model/config/live_tuning.hpp"
 
@@ -25,15 +28,129 @@ const char* const kTopicNames[kNumTopics] = {"GroundTruth",  "SensorData",     "
                                              "JointCommand", "WbcDiagnostics", "OperatorCommand", "Disturbance",
                                              "ConfigChange"};
 
-std::vector<std::string> withTick(std::vector<std::string> cols) {
-  cols.insert(cols.begin(), "tick");
-  return cols;
-}
-std::vector<std::string> unitsWithTick(std::vector<std::string> u) {
-  u.insert(u.begin(), "-");
-  return u;
-}
 std::vector<std::string> repeat(const std::string& u, std::size_t n) { return std::vector<std::string>(n, u); }
+
+// ---- the layout tables ----
+// Each label is one table of fields; the writer, the reader and the column names (CSV export, metadata) all
+// follow from it, so the three cannot disagree.
+
+// `columns.size()` consecutive AIN_double channels of a message.
+struct ChannelField {
+  std::vector<std::string> columns, units;
+  std::function<void(const Message&, double*)> write;
+  std::function<void(const double*, Message*)> read;
+};
+// One CObservationIMU entry. `column` empty: stored for MRPT tools, not exported; `read` empty: derived, not
+// read back.
+struct ImuField {
+  mrpt::obs::TIMUDataIndex index;
+  std::string column, unit;
+  std::function<double(const Message&)> write;
+  std::function<void(double, Message*)> read;
+};
+struct LabelLayout {
+  std::string label;
+  Topic topic;
+  LabelClass cls;
+  std::string description;
+  std::vector<ChannelField> channels;  // RawDaq
+  std::vector<ImuField> imu;           // Imu
+};
+
+// An accessor of a generated message member: the value when const, a reference to it otherwise.
+#define MFT_MEMBER(name) [](auto& msg) -> decltype(auto) { return msg.name(); }
+
+// One number; stored as double, read back with a cast to the member's type (flags: != 0).
+template <class M, class Access>
+ChannelField scalar(const std::string& column, const std::string& unit, Access access) {
+  return {{column},
+          {unit},
+          [access](const Message& m, double* out) { *out = static_cast<double>(access(std::get<M>(m))); },
+          [access](const double* in, Message* m) {
+            decltype(auto) member = access(std::get<M>(*m));
+            member = static_cast<std::decay_t<decltype(member)>>(*in);
+          }};
+}
+
+// A fixed-size array, element by element.
+template <class M, class Access>
+ChannelField array(std::vector<std::string> columns, std::vector<std::string> units, Access access) {
+  using A = std::decay_t<decltype(access(std::declval<M&>()))>;
+  if (columns.size() != std::tuple_size<A>::value || units.size() != columns.size())
+    throw std::logic_error("rawlog layout: column count of " + columns.front() + " does not match the message");
+  return {std::move(columns), std::move(units),
+          [access](const Message& m, double* out) {
+            for (const auto& v : access(std::get<M>(m))) *out++ = static_cast<double>(v);
+          },
+          [access](const double* in, Message* m) {
+            for (auto& v : access(std::get<M>(*m))) v = static_cast<typename A::value_type>(*in++);
+          }};
+}
+
+template <class M>
+ChannelField tick() {
+  return scalar<M>("tick", "-", MFT_MEMBER(tick));
+}
+
+// The encoders in joint order: actuated and passive joints alternate (q4 actuated, q5 passive, ...).
+template <class Actuated, class Passive>
+ChannelField jointOrder(std::vector<std::string> columns, const std::string& unit, Actuated actuated, Passive passive) {
+  const auto n = columns.size();
+  return {std::move(columns), repeat(unit, n),
+          [actuated, passive](const Message& m, double* out) {
+            const auto& s = std::get<msg::SensorData>(m);
+            for (std::size_t i = 0; i < 4; ++i) {
+              *out++ = actuated(s)[i];
+              *out++ = passive(s)[i];
+            }
+          },
+          [actuated, passive](const double* in, Message* m) {
+            auto& s = std::get<msg::SensorData>(*m);
+            for (std::size_t i = 0; i < 4; ++i) {
+              actuated(s)[i] = *in++;
+              passive(s)[i] = *in++;
+            }
+          }};
+}
+
+// ConfigChange's key, stored as its index in tunableKeys() (-1: not tunable, read back as "").
+ChannelField configKey() {
+  return {{"key"}, {"-"},
+          [](const Message& m, double* out) {
+            const auto& c = std::get<msg::ConfigChange>(m);
+            const std::string key(c.key().data(), strnlen(c.key().data(), c.key().size()));
+            *out = static_cast<double>(
+                config::tunableIndex(c.target() == msg::CONFIG_TARGET_PLANNER ? "planner" : "wbc", key));
+          },
+          [](const double* in, Message* m) {
+            auto& c = std::get<msg::ConfigChange>(*m);
+            const auto& keys = config::tunableKeys();
+            c.key().fill('\0');
+            if (*in >= 0.0 && *in < static_cast<double>(keys.size()))
+              std::snprintf(c.key().data(), c.key().size(), "%s", keys[static_cast<std::size_t>(*in)].key);
+          }};
+}
+
+// ConfigChange's numbers; reading them also restores the value text (after `count`, which comes first).
+ChannelField configValues() {
+  ChannelField f = array<msg::ConfigChange>({"value_0", "value_1"}, {"-", "-"}, MFT_MEMBER(number));
+  const auto read_numbers = f.read;
+  f.read = [read_numbers](const double* in, Message* m) {
+    read_numbers(in, m);
+    auto& c = std::get<msg::ConfigChange>(*m);
+    const std::string value = config::formatNumbers(c.number().data(), std::min<std::size_t>(c.count(), 2));
+    c.value().fill('\0');
+    if (c.count() > 0) std::snprintf(c.value().data(), c.value().size(), "%s", value.c_str());
+  };
+  return f;
+}
+
+LabelLayout rawDaq(std::string label, Topic topic, std::string description, std::vector<ChannelField> channels) {
+  return {std::move(label), topic, LabelClass::RawDaq, std::move(description), std::move(channels), {}};
+}
+LabelLayout imu(std::string label, Topic topic, std::string description, std::vector<ImuField> fields) {
+  return {std::move(label), topic, LabelClass::Imu, std::move(description), {}, std::move(fields)};
+}
 
 const std::vector<std::string> kJoints = {"q4", "q5", "q6", "q7", "q8", "q9", "q10", "q11"};
 const std::vector<std::string> kJointsDot = {"qd4", "qd5", "qd6", "qd7", "qd8", "qd9", "qd10", "qd11"};
@@ -43,329 +160,156 @@ const std::vector<std::string> kQUnits = {"m", "m", "rad", "rad", "rad", "rad", 
 const std::vector<std::string> kQdUnits = {"m/s", "m/s", "rad/s", "rad/s", "rad/s", "rad/s", "rad/s", "rad/s",
                                            "rad/s", "rad/s", "rad/s"};
 
-std::vector<LabelSpec> makeLabels() {
-  std::vector<LabelSpec> l;
+// Every label of schema 1 in writing order: channel order here is the on-disk order (never reorder without
+// bumping kSchemaVersion).
+std::vector<LabelLayout> makeLayouts() {
+  using namespace msg;
+  using mrpt::obs::TIMUDataIndex;
+  const auto sensor = [](const Message& m) -> const SensorData& { return std::get<SensorData>(m); };
+  const auto state = [](const Message& m) -> const RobotState& { return std::get<RobotState>(m); };
+  std::vector<LabelLayout> l;
   // GroundTruth
-  l.push_back({"gt_q", Topic::GroundTruth, LabelClass::RawDaq, withTick(kQ), unitsWithTick(kQUnits),
-               "simulator ground truth q = [x, z, pitch, q4..q11]"});
-  l.push_back({"gt_qd", Topic::GroundTruth, LabelClass::RawDaq, withTick(kQd), unitsWithTick(kQdUnits),
-               "simulator ground truth qd"});
-  l.push_back({"contact_force", Topic::GroundTruth, LabelClass::RawDaq, withTick({"fx_right", "fz_right", "fx_left", "fz_left"}),
-               unitsWithTick(repeat("N", 4)), "ground on foot, world frame"});
-  l.push_back({"leg_lti", Topic::GroundTruth, LabelClass::RawDaq, withTick({"lti_right", "lti_left"}),
-               unitsWithTick(repeat("-", 2)), "local transmission index of each leg (ground truth)"});
+  l.push_back(rawDaq("gt_q", Topic::GroundTruth, "simulator ground truth q = [x, z, pitch, q4..q11]",
+                     {tick<GroundTruth>(), array<GroundTruth>(kQ, kQUnits, MFT_MEMBER(q))}));
+  l.push_back(rawDaq("gt_qd", Topic::GroundTruth, "simulator ground truth qd",
+                     {tick<GroundTruth>(), array<GroundTruth>(kQd, kQdUnits, MFT_MEMBER(qd))}));
+  l.push_back(rawDaq("contact_force", Topic::GroundTruth, "ground on foot, world frame",
+                     {tick<GroundTruth>(), array<GroundTruth>({"fx_right", "fz_right", "fx_left", "fz_left"},
+                                                              repeat("N", 4), MFT_MEMBER(contact_force))}));
+  l.push_back(rawDaq("leg_lti", Topic::GroundTruth, "local transmission index of each leg (ground truth)",
+                     {tick<GroundTruth>(), array<GroundTruth>({"lti_right", "lti_left"}, repeat("-", 2), MFT_MEMBER(lti))}));
   // SensorData
-  l.push_back({"joint_q", Topic::SensorData, LabelClass::RawDaq, withTick(kJoints), unitsWithTick(repeat("rad", 8)),
-               "encoder positions in joint order (actuated q4 q6 q8 q10, passive q5 q7 q9 q11), unwrapped"});
-  l.push_back({"joint_qd", Topic::SensorData, LabelClass::RawDaq, withTick(kJointsDot), unitsWithTick(repeat("rad/s", 8)),
-               "encoder velocities in joint order"});
-  l.push_back({"joint_tau_meas", Topic::SensorData, LabelClass::RawDaq, withTick({"tau_q4", "tau_q6", "tau_q8", "tau_q10"}),
-               unitsWithTick(repeat("N m", 4)), "measured SEA output torques of the actuated joints"});
-  l.push_back({"imu", Topic::SensorData, LabelClass::Imu, {"IMU_WY", "IMU_X_ACC", "IMU_Z_ACC"},
-               {"rad/s", "m/s^2", "m/s^2"},
-               "torso IMU, body frame x forward y left z up: IMU_WY = -gyro_pitch_rate (pitch is CCW about -y), "
-               "IMU_X_ACC/IMU_Z_ACC = specific force [x, z]"});
-  l.push_back({"foot_switch", Topic::SensorData, LabelClass::RawDaq, withTick({"right", "left"}),
-               unitsWithTick(repeat("0/1", 2)), "foot contact switches"});
+  l.push_back(rawDaq("joint_q", Topic::SensorData,
+                     "encoder positions in joint order (actuated q4 q6 q8 q10, passive q5 q7 q9 q11), unwrapped",
+                     {tick<SensorData>(), jointOrder(kJoints, "rad", MFT_MEMBER(actuated_pos), MFT_MEMBER(passive_pos))}));
+  l.push_back(rawDaq("joint_qd", Topic::SensorData, "encoder velocities in joint order",
+                     {tick<SensorData>(), jointOrder(kJointsDot, "rad/s", MFT_MEMBER(actuated_vel), MFT_MEMBER(passive_vel))}));
+  l.push_back(rawDaq("joint_tau_meas", Topic::SensorData, "measured SEA output torques of the actuated joints",
+                     {tick<SensorData>(), array<SensorData>({"tau_q4", "tau_q6", "tau_q8", "tau_q10"}, repeat("N m", 4),
+                                                            MFT_MEMBER(sea_torque))}));
+  l.push_back(imu("imu", Topic::SensorData,
+                  "torso IMU, body frame x forward y left z up: IMU_WY = -gyro_pitch_rate (pitch is CCW about -y), "
+                  "IMU_X_ACC/IMU_Z_ACC = specific force [x, z]",
+                  {{mrpt::obs::IMU_WY, "IMU_WY", "rad/s", [=](const Message& m) { return -sensor(m).gyro_pitch_rate(); },
+                    [](double v, Message* m) { std::get<SensorData>(*m).gyro_pitch_rate(-v); }},
+                   {mrpt::obs::IMU_X_ACC, "IMU_X_ACC", "m/s^2", [=](const Message& m) { return sensor(m).accel()[0]; },
+                    [](double v, Message* m) { std::get<SensorData>(*m).accel()[0] = v; }},
+                   {mrpt::obs::IMU_Z_ACC, "IMU_Z_ACC", "m/s^2", [=](const Message& m) { return sensor(m).accel()[1]; },
+                    [](double v, Message* m) { std::get<SensorData>(*m).accel()[1] = v; }}}));
+  l.push_back(rawDaq("foot_switch", Topic::SensorData, "foot contact switches",
+                     {tick<SensorData>(), array<SensorData>({"right", "left"}, repeat("0/1", 2), MFT_MEMBER(contact))}));
   // RobotState
-  l.push_back({"est_q", Topic::RobotState, LabelClass::RawDaq, withTick(kQ), unitsWithTick(kQUnits),
-               "estimated q (the controller's input, exact)"});
-  l.push_back({"est_qd", Topic::RobotState, LabelClass::RawDaq, withTick(kQd), unitsWithTick(kQdUnits), "estimated qd"});
-  l.push_back({"est_contact", Topic::RobotState, LabelClass::RawDaq, withTick({"right", "left"}),
-               unitsWithTick(repeat("0/1", 2)), "estimated contact flags"});
-  l.push_back({"base_est", Topic::RobotState, LabelClass::Imu,
-               {"IMU_X", "IMU_Z", "IMU_PITCH", "IMU_X_VEL", "IMU_Z_VEL", "IMU_WY", "IMU_ORI_QUAT_W", "IMU_ORI_QUAT_Y"},
-               {"m", "m", "rad", "m/s", "m/s", "rad/s", "-", "-"},
-               "derived view of est_q/est_qd as a virtual INS for MRPT tools (MRPT pitch = -pitch, IMU_WY = -pitchd, "
-               "quaternion of the rotation about y by -pitch); est_q/est_qd hold the exact values"});
+  l.push_back(rawDaq("est_q", Topic::RobotState, "estimated q (the controller's input, exact)",
+                     {tick<RobotState>(), array<RobotState>(kQ, kQUnits, MFT_MEMBER(q))}));
+  l.push_back(rawDaq("est_qd", Topic::RobotState, "estimated qd",
+                     {tick<RobotState>(), array<RobotState>(kQd, kQdUnits, MFT_MEMBER(qd))}));
+  l.push_back(rawDaq("est_contact", Topic::RobotState, "estimated contact flags",
+                     {tick<RobotState>(), array<RobotState>({"right", "left"}, repeat("0/1", 2), MFT_MEMBER(contact))}));
+  // A derived view for MRPT tools, not read back (est_q/est_qd hold the values). MRPT's pitch is -pitch.
+  const auto pitch = [=](const Message& m) { return state(m).q()[2]; };
+  const auto zero = [](const Message&) { return 0.0; };
+  l.push_back(imu("base_est", Topic::RobotState,
+                  "derived view of est_q/est_qd as a virtual INS for MRPT tools (MRPT pitch = -pitch, IMU_WY = -pitchd, "
+                  "quaternion of the rotation about y by -pitch); est_q/est_qd hold the exact values",
+                  {{mrpt::obs::IMU_X, "IMU_X", "m", [=](const Message& m) { return state(m).q()[0]; }, {}},
+                   {mrpt::obs::IMU_Z, "IMU_Z", "m", [=](const Message& m) { return state(m).q()[1]; }, {}},
+                   {mrpt::obs::IMU_PITCH, "IMU_PITCH", "rad", [=](const Message& m) { return -pitch(m); }, {}},
+                   {mrpt::obs::IMU_X_VEL, "IMU_X_VEL", "m/s", [=](const Message& m) { return state(m).qd()[0]; }, {}},
+                   {mrpt::obs::IMU_Z_VEL, "IMU_Z_VEL", "m/s", [=](const Message& m) { return state(m).qd()[1]; }, {}},
+                   {mrpt::obs::IMU_WY, "IMU_WY", "rad/s", [=](const Message& m) { return -state(m).qd()[2]; }, {}},
+                   {mrpt::obs::IMU_ORI_QUAT_W, "IMU_ORI_QUAT_W", "-",
+                    [=](const Message& m) { return std::cos(-pitch(m) / 2); }, {}},
+                   {mrpt::obs::IMU_ORI_QUAT_Y, "IMU_ORI_QUAT_Y", "-",
+                    [=](const Message& m) { return std::sin(-pitch(m) / 2); }, {}},
+                   {mrpt::obs::IMU_Y, "", "", zero, {}},
+                   {mrpt::obs::IMU_PITCH_VEL_GLOBAL, "", "", [=](const Message& m) { return -state(m).qd()[2]; }, {}},
+                   {mrpt::obs::IMU_ORI_QUAT_X, "", "", zero, {}},
+                   {mrpt::obs::IMU_ORI_QUAT_Z, "", "", zero, {}}}));
   // Reference
-  l.push_back({"plan_ref", Topic::Reference, LabelClass::RawDaq,
-               withTick({"step_index", "phase", "stance_leg", "in_stance_right", "in_stance_left", "base_z", "base_zd",
-                         "base_zdd", "pitch", "pitchd", "pitchdd", "foot_x_right", "foot_z_right", "foot_x_left",
-                         "foot_z_left", "foot_vx_right", "foot_vz_right", "foot_vx_left", "foot_vz_left",
-                         "foot_ax_right", "foot_az_right", "foot_ax_left", "foot_az_left", "base_x", "base_xd",
-                         "base_xdd", "hold_base_x"}),
-               unitsWithTick({"-", "-", "-", "0/1", "0/1", "m", "m/s", "m/s^2", "rad", "rad/s", "rad/s^2", "m", "m", "m",
-                              "m", "m/s", "m/s", "m/s", "m/s", "m/s^2", "m/s^2", "m/s^2", "m/s^2", "m", "m/s", "m/s^2",
-                              "0/1"}),
-               "planner reference (stance_leg 0 right, 1 left, -1 double support)"});
+  l.push_back(rawDaq(
+      "plan_ref", Topic::Reference, "planner reference (stance_leg 0 right, 1 left, -1 double support)",
+      {tick<Reference>(), scalar<Reference>("step_index", "-", MFT_MEMBER(step_index)),
+       scalar<Reference>("phase", "-", MFT_MEMBER(phase)), scalar<Reference>("stance_leg", "-", MFT_MEMBER(stance_leg)),
+       array<Reference>({"in_stance_right", "in_stance_left"}, repeat("0/1", 2), MFT_MEMBER(foot_in_stance)),
+       array<Reference>({"base_z", "base_zd", "base_zdd"}, {"m", "m/s", "m/s^2"}, MFT_MEMBER(base_z)),
+       array<Reference>({"pitch", "pitchd", "pitchdd"}, {"rad", "rad/s", "rad/s^2"}, MFT_MEMBER(base_pitch)),
+       array<Reference>({"foot_x_right", "foot_z_right", "foot_x_left", "foot_z_left"}, repeat("m", 4), MFT_MEMBER(foot_pos)),
+       array<Reference>({"foot_vx_right", "foot_vz_right", "foot_vx_left", "foot_vz_left"}, repeat("m/s", 4),
+                        MFT_MEMBER(foot_vel)),
+       array<Reference>({"foot_ax_right", "foot_az_right", "foot_ax_left", "foot_az_left"}, repeat("m/s^2", 4),
+                        MFT_MEMBER(foot_acc)),
+       array<Reference>({"base_x", "base_xd", "base_xdd"}, {"m", "m/s", "m/s^2"}, MFT_MEMBER(base_x)),
+       scalar<Reference>("hold_base_x", "0/1", MFT_MEMBER(hold_base_x))}));
   // JointCommand
-  l.push_back({"joint_tau_cmd", Topic::JointCommand, LabelClass::RawDaq,
-               withTick({"seq", "tau_q4", "tau_q6", "tau_q8", "tau_q10", "mode"}),
-               unitsWithTick({"-", "N m", "N m", "N m", "N m", "-"}), "commanded torques (mode 0 normal, 1 damping)"});
+  l.push_back(rawDaq("joint_tau_cmd", Topic::JointCommand, "commanded torques (mode 0 normal, 1 damping)",
+                     {tick<JointCommand>(), scalar<JointCommand>("seq", "-", MFT_MEMBER(seq)),
+                      array<JointCommand>({"tau_q4", "tau_q6", "tau_q8", "tau_q10"}, repeat("N m", 4), MFT_MEMBER(tau)),
+                      scalar<JointCommand>("mode", "-", MFT_MEMBER(mode))}));
   // WbcDiagnostics
-  l.push_back({"wbc_diag", Topic::WbcDiagnostics, LabelClass::RawDaq,
-               withTick({"solve_time_us", "tick_time_us", "iterations", "status", "active_constraints", "slack_norm",
-                         "err_base_z", "err_base_pitch", "err_foot_x_right", "err_foot_z_right", "err_foot_x_left",
-                         "err_foot_z_left", "lti_right", "lti_left", "raci_right", "raci_left", "safety_events",
-                         "holding", "damping"}),
-               unitsWithTick({"us", "us", "-", "-", "-", "rad", "m", "rad", "m", "m", "m", "m", "-", "-", "N/sqrt(kg)",
-                              "N/sqrt(kg)", "-", "0/1", "0/1"}),
-               "WBC diagnostics (status 0 = optimal)"});
+  l.push_back(rawDaq(
+      "wbc_diag", Topic::WbcDiagnostics, "WBC diagnostics (status 0 = optimal)",
+      {tick<WbcDiagnostics>(), scalar<WbcDiagnostics>("solve_time_us", "us", MFT_MEMBER(solve_time_us)),
+       scalar<WbcDiagnostics>("tick_time_us", "us", MFT_MEMBER(tick_time_us)),
+       scalar<WbcDiagnostics>("iterations", "-", MFT_MEMBER(iterations)),
+       scalar<WbcDiagnostics>("status", "-", MFT_MEMBER(status)),
+       scalar<WbcDiagnostics>("active_constraints", "-", MFT_MEMBER(active_constraints)),
+       scalar<WbcDiagnostics>("slack_norm", "rad", MFT_MEMBER(slack_norm)),
+       array<WbcDiagnostics>({"err_base_z", "err_base_pitch", "err_foot_x_right", "err_foot_z_right", "err_foot_x_left",
+                              "err_foot_z_left"},
+                             {"m", "rad", "m", "m", "m", "m"}, MFT_MEMBER(task_error)),
+       array<WbcDiagnostics>({"lti_right", "lti_left"}, repeat("-", 2), MFT_MEMBER(lti)),
+       array<WbcDiagnostics>({"raci_right", "raci_left"}, repeat("N/sqrt(kg)", 2), MFT_MEMBER(raci)),
+       scalar<WbcDiagnostics>("safety_events", "-", MFT_MEMBER(safety_events)),
+       scalar<WbcDiagnostics>("holding", "0/1", MFT_MEMBER(holding)),
+       scalar<WbcDiagnostics>("damping", "0/1", MFT_MEMBER(damping))}));
   // Events: channel 0 is the message's seq; stamped with the newest simulator time seen on arrival.
-  l.push_back({"operator_cmd", Topic::OperatorCommand, LabelClass::RawDaq, {"seq", "z_cmd", "v_cmd", "mode"},
-               {"-", "m", "m/s", "-"}, "operator command (mode 0 stand, 1 step in place, 2 walk)"});
-  l.push_back({"disturbance", Topic::Disturbance, LabelClass::RawDaq, {"seq", "impulse_Ns", "trigger", "time_s", "leg"},
-               {"-", "N s", "-", "s", "-"}, "push request (trigger 0 at time, 1 at next lift-off of leg)"});
+  l.push_back(rawDaq("operator_cmd", Topic::OperatorCommand, "operator command (mode 0 stand, 1 step in place, 2 walk)",
+                     {scalar<OperatorCommand>("seq", "-", MFT_MEMBER(seq)),
+                      scalar<OperatorCommand>("z_cmd", "m", MFT_MEMBER(z_cmd)),
+                      scalar<OperatorCommand>("v_cmd", "m/s", MFT_MEMBER(v_cmd)),
+                      scalar<OperatorCommand>("mode", "-", MFT_MEMBER(mode))}));
+  l.push_back(rawDaq("disturbance", Topic::Disturbance, "push request (trigger 0 at time, 1 at next lift-off of leg)",
+                     {scalar<Disturbance>("seq", "-", MFT_MEMBER(seq)),
+                      scalar<Disturbance>("impulse_Ns", "N s", MFT_MEMBER(impulse)),
+                      scalar<Disturbance>("trigger", "-", MFT_MEMBER(trigger)),
+                      scalar<Disturbance>("time_s", "s", MFT_MEMBER(time_s)),
+                      scalar<Disturbance>("leg", "-", MFT_MEMBER(leg))}));
   // Appended after schema 1's first labels: a reader that predates it ignores the label (counted as unknown).
-  l.push_back({"config_change", Topic::ConfigChange, LabelClass::RawDaq,
-               {"seq", "applied", "target", "key", "at_s", "tick", "count", "value_0", "value_1"},
-               {"-", "0/1", "-", "-", "s", "-", "-", "-", "-"},
-               "live tuning (mft-cmd --set): a request (applied 0) or a change in force from tick (applied 1); target "
-               "0 wbc.yaml, 1 planner.yaml; key = index in model/config/live_tuning.cpp tunableKeys() (-1: not "
-               "tunable); value_0/value_1 the value as loaded (count of them), requests hold none"});
+  l.push_back(rawDaq("config_change", Topic::ConfigChange,
+                     "live tuning (mft-cmd --set): a request (applied 0) or a change in force from tick (applied 1); "
+                     "target 0 wbc.yaml, 1 planner.yaml; key = index in model/config/live_tuning.cpp tunableKeys() (-1: "
+                     "not tunable); value_0/value_1 the value as loaded (count of them), requests hold none",
+                     {scalar<ConfigChange>("seq", "-", MFT_MEMBER(seq)),
+                      scalar<ConfigChange>("applied", "0/1", MFT_MEMBER(applied)),
+                      scalar<ConfigChange>("target", "-", MFT_MEMBER(target)), configKey(),
+                      scalar<ConfigChange>("at_s", "s", MFT_MEMBER(at_s)),
+                      scalar<ConfigChange>("tick", "-", MFT_MEMBER(tick)),
+                      scalar<ConfigChange>("count", "-", MFT_MEMBER(count)), configValues()}));
+  return l;
+}
+#undef MFT_MEMBER
+
+const std::vector<LabelLayout>& layouts() {
+  static const std::vector<LabelLayout> l = makeLayouts();
   return l;
 }
 
-template <std::size_t N>
-void put(double*& p, const std::array<double, N>& a) {
-  for (double v : a) *p++ = v;
-}
-template <std::size_t N>
-void get(const double*& p, std::array<double, N>& a) {
-  for (double& v : a) v = *p++;
-}
-double b2d(bool b) { return b ? 1.0 : 0.0; }
-bool d2b(double d) { return d != 0.0; }
-std::uint64_t d2u(double d) { return static_cast<std::uint64_t>(d); }
-
-// RawDAQ channels of label `li` from message `m` (the caller sized `out` to the column count).
-void toChannels(const Message& m, const std::string& label, double* p) {
-  switch (topicOf(m)) {
-    case Topic::GroundTruth: {
-      const auto& g = std::get<msg::GroundTruth>(m);
-      *p++ = static_cast<double>(g.tick());
-      if (label == "gt_q") put(p, g.q());
-      else if (label == "gt_qd") put(p, g.qd());
-      else if (label == "contact_force") put(p, g.contact_force());
-      else put(p, g.lti());
-      break;
+std::vector<LabelSpec> makeLabels() {
+  std::vector<LabelSpec> specs;
+  for (const auto& layout : layouts()) {
+    LabelSpec s{layout.label, layout.topic, layout.cls, {}, {}, layout.description};
+    for (const auto& f : layout.channels) {
+      s.columns.insert(s.columns.end(), f.columns.begin(), f.columns.end());
+      s.units.insert(s.units.end(), f.units.begin(), f.units.end());
     }
-    case Topic::SensorData: {
-      const auto& s = std::get<msg::SensorData>(m);
-      *p++ = static_cast<double>(s.tick());
-      if (label == "joint_q" || label == "joint_qd") {
-        const auto& a = label == "joint_q" ? s.actuated_pos() : s.actuated_vel();
-        const auto& b = label == "joint_q" ? s.passive_pos() : s.passive_vel();
-        for (std::size_t i = 0; i < 4; ++i) {
-          *p++ = a[i];
-          *p++ = b[i];
-        }
-      } else if (label == "joint_tau_meas") {
-        put(p, s.sea_torque());
-      } else {  // foot_switch
-        *p++ = b2d(s.contact()[0]);
-        *p++ = b2d(s.contact()[1]);
+    for (const auto& f : layout.imu)
+      if (!f.column.empty()) {
+        s.columns.push_back(f.column);
+        s.units.push_back(f.unit);
       }
-      break;
-    }
-    case Topic::RobotState: {
-      const auto& r = std::get<msg::RobotState>(m);
-      *p++ = static_cast<double>(r.tick());
-      if (label == "est_q") put(p, r.q());
-      else if (label == "est_qd") put(p, r.qd());
-      else {
-        *p++ = b2d(r.contact()[0]);
-        *p++ = b2d(r.contact()[1]);
-      }
-      break;
-    }
-    case Topic::Reference: {
-      const auto& r = std::get<msg::Reference>(m);
-      *p++ = static_cast<double>(r.tick());
-      *p++ = static_cast<double>(r.step_index());
-      *p++ = r.phase();
-      *p++ = static_cast<double>(r.stance_leg());
-      *p++ = b2d(r.foot_in_stance()[0]);
-      *p++ = b2d(r.foot_in_stance()[1]);
-      put(p, r.base_z());
-      put(p, r.base_pitch());
-      put(p, r.foot_pos());
-      put(p, r.foot_vel());
-      put(p, r.foot_acc());
-      put(p, r.base_x());
-      *p++ = b2d(r.hold_base_x());
-      break;
-    }
-    case Topic::JointCommand: {
-      const auto& c = std::get<msg::JointCommand>(m);
-      *p++ = static_cast<double>(c.tick());
-      *p++ = static_cast<double>(c.seq());
-      put(p, c.tau());
-      *p++ = static_cast<double>(c.mode());
-      break;
-    }
-    case Topic::WbcDiagnostics: {
-      const auto& d = std::get<msg::WbcDiagnostics>(m);
-      *p++ = static_cast<double>(d.tick());
-      *p++ = d.solve_time_us();
-      *p++ = d.tick_time_us();
-      *p++ = d.iterations();
-      *p++ = d.status();
-      *p++ = d.active_constraints();
-      *p++ = d.slack_norm();
-      put(p, d.task_error());
-      put(p, d.lti());
-      put(p, d.raci());
-      *p++ = static_cast<double>(d.safety_events());
-      *p++ = b2d(d.holding());
-      *p++ = b2d(d.damping());
-      break;
-    }
-    case Topic::OperatorCommand: {
-      const auto& o = std::get<msg::OperatorCommand>(m);
-      *p++ = static_cast<double>(o.seq());
-      *p++ = o.z_cmd();
-      *p++ = o.v_cmd();
-      *p++ = o.mode();
-      break;
-    }
-    case Topic::Disturbance: {
-      const auto& d = std::get<msg::Disturbance>(m);
-      *p++ = static_cast<double>(d.seq());
-      *p++ = d.impulse();
-      *p++ = d.trigger();
-      *p++ = d.time_s();
-      *p++ = d.leg();
-      break;
-    }
-    case Topic::ConfigChange: {
-      const auto& c = std::get<msg::ConfigChange>(m);
-      const std::string key(c.key().data(), strnlen(c.key().data(), c.key().size()));
-      *p++ = static_cast<double>(c.seq());
-      *p++ = b2d(c.applied());
-      *p++ = static_cast<double>(c.target());
-      *p++ = static_cast<double>(
-          config::tunableIndex(c.target() == msg::CONFIG_TARGET_PLANNER ? "planner" : "wbc", key));
-      *p++ = c.at_s();
-      *p++ = static_cast<double>(c.tick());
-      *p++ = static_cast<double>(c.count());
-      put(p, c.number());
-      break;
-    }
+    specs.push_back(std::move(s));
   }
-}
-
-// The inverse: fills the part of `m` that label `label` holds.
-void fromChannels(const std::string& label, const double* p, Message* m) {
-  switch (topicOf(*m)) {
-    case Topic::GroundTruth: {
-      auto& g = std::get<msg::GroundTruth>(*m);
-      g.tick(d2u(*p++));
-      if (label == "gt_q") get(p, g.q());
-      else if (label == "gt_qd") get(p, g.qd());
-      else if (label == "contact_force") get(p, g.contact_force());
-      else get(p, g.lti());
-      break;
-    }
-    case Topic::SensorData: {
-      auto& s = std::get<msg::SensorData>(*m);
-      s.tick(d2u(*p++));
-      if (label == "joint_q" || label == "joint_qd") {
-        auto& a = label == "joint_q" ? s.actuated_pos() : s.actuated_vel();
-        auto& b = label == "joint_q" ? s.passive_pos() : s.passive_vel();
-        for (std::size_t i = 0; i < 4; ++i) {
-          a[i] = *p++;
-          b[i] = *p++;
-        }
-      } else if (label == "joint_tau_meas") {
-        get(p, s.sea_torque());
-      } else {
-        s.contact()[0] = d2b(*p++);
-        s.contact()[1] = d2b(*p++);
-      }
-      break;
-    }
-    case Topic::RobotState: {
-      auto& r = std::get<msg::RobotState>(*m);
-      r.tick(d2u(*p++));
-      if (label == "est_q") get(p, r.q());
-      else if (label == "est_qd") get(p, r.qd());
-      else {
-        r.contact()[0] = d2b(*p++);
-        r.contact()[1] = d2b(*p++);
-      }
-      break;
-    }
-    case Topic::Reference: {
-      auto& r = std::get<msg::Reference>(*m);
-      r.tick(d2u(*p++));
-      r.step_index(d2u(*p++));
-      r.phase(*p++);
-      r.stance_leg(static_cast<std::int16_t>(*p++));
-      r.foot_in_stance()[0] = d2b(*p++);
-      r.foot_in_stance()[1] = d2b(*p++);
-      get(p, r.base_z());
-      get(p, r.base_pitch());
-      get(p, r.foot_pos());
-      get(p, r.foot_vel());
-      get(p, r.foot_acc());
-      get(p, r.base_x());
-      r.hold_base_x(d2b(*p++));
-      break;
-    }
-    case Topic::JointCommand: {
-      auto& c = std::get<msg::JointCommand>(*m);
-      c.tick(d2u(*p++));
-      c.seq(d2u(*p++));
-      get(p, c.tau());
-      c.mode(static_cast<std::uint8_t>(*p++));
-      break;
-    }
-    case Topic::WbcDiagnostics: {
-      auto& d = std::get<msg::WbcDiagnostics>(*m);
-      d.tick(d2u(*p++));
-      d.solve_time_us(*p++);
-      d.tick_time_us(*p++);
-      d.iterations(static_cast<std::int32_t>(*p++));
-      d.status(static_cast<std::int32_t>(*p++));
-      d.active_constraints(static_cast<std::int32_t>(*p++));
-      d.slack_norm(*p++);
-      get(p, d.task_error());
-      get(p, d.lti());
-      get(p, d.raci());
-      d.safety_events(d2u(*p++));
-      d.holding(d2b(*p++));
-      d.damping(d2b(*p++));
-      break;
-    }
-    case Topic::OperatorCommand: {
-      auto& o = std::get<msg::OperatorCommand>(*m);
-      o.seq(d2u(*p++));
-      o.z_cmd(*p++);
-      o.v_cmd(*p++);
-      o.mode(static_cast<std::uint8_t>(*p++));
-      break;
-    }
-    case Topic::Disturbance: {
-      auto& d = std::get<msg::Disturbance>(*m);
-      d.seq(d2u(*p++));
-      d.impulse(*p++);
-      d.trigger(static_cast<std::uint8_t>(*p++));
-      d.time_s(*p++);
-      d.leg(static_cast<std::int16_t>(*p++));
-      break;
-    }
-    case Topic::ConfigChange: {
-      auto& c = std::get<msg::ConfigChange>(*m);
-      c.seq(d2u(*p++));
-      c.applied(d2b(*p++));
-      c.target(static_cast<std::uint8_t>(*p++));
-      const double key = *p++;
-      const auto& keys = config::tunableKeys();
-      c.key().fill('\0');
-      if (key >= 0.0 && key < static_cast<double>(keys.size()))
-        std::snprintf(c.key().data(), c.key().size(), "%s", keys[static_cast<std::size_t>(key)].key);
-      c.at_s(*p++);
-      c.tick(d2u(*p++));
-      c.count(static_cast<std::uint8_t>(*p++));
-      get(p, c.number());
-      const std::string value = config::formatNumbers(c.number().data(), std::min<std::size_t>(c.count(), 2));
-      c.value().fill('\0');
-      if (c.count() > 0) std::snprintf(c.value().data(), c.value().size(), "%s", value.c_str());
-      break;
-    }
-  }
+  return specs;
 }
 
 Message emptyMessage(Topic t) {
@@ -482,34 +426,18 @@ const std::vector<int>& ObservationEncoder::encode(const Message& m, std::int64_
   const auto& idx = topicLabels(topicOf(m));
   const auto t = toMrptTime(unix_ns);
   for (int li : idx) {
-    const auto& spec = labels()[static_cast<std::size_t>(li)];
+    const auto& layout = layouts()[static_cast<std::size_t>(li)];
     auto& base = obs_[static_cast<std::size_t>(li)];
     base->timestamp = t;
-    if (spec.cls == LabelClass::RawDaq) {
-      auto& o = static_cast<CObservationRawDAQ&>(*base);
-      toChannels(m, spec.label, o.AIN_double.data());
-    } else if (spec.label == "imu") {
+    if (layout.cls == LabelClass::RawDaq) {
+      double* channel = static_cast<CObservationRawDAQ&>(*base).AIN_double.data();
+      for (const auto& f : layout.channels) {
+        f.write(m, channel);
+        channel += f.columns.size();
+      }
+    } else {
       auto& o = static_cast<CObservationIMU&>(*base);
-      const auto& s = std::get<msg::SensorData>(m);
-      o.set(mrpt::obs::IMU_WY, -s.gyro_pitch_rate());
-      o.set(mrpt::obs::IMU_X_ACC, s.accel()[0]);
-      o.set(mrpt::obs::IMU_Z_ACC, s.accel()[1]);
-    } else {  // base_est
-      auto& o = static_cast<CObservationIMU&>(*base);
-      const auto& r = std::get<msg::RobotState>(m);
-      const double pitch = r.q()[2];
-      o.set(mrpt::obs::IMU_X, r.q()[0]);
-      o.set(mrpt::obs::IMU_Y, 0.0);
-      o.set(mrpt::obs::IMU_Z, r.q()[1]);
-      o.set(mrpt::obs::IMU_PITCH, -pitch);
-      o.set(mrpt::obs::IMU_X_VEL, r.qd()[0]);
-      o.set(mrpt::obs::IMU_Z_VEL, r.qd()[1]);
-      o.set(mrpt::obs::IMU_WY, -r.qd()[2]);
-      o.set(mrpt::obs::IMU_PITCH_VEL_GLOBAL, -r.qd()[2]);
-      o.set(mrpt::obs::IMU_ORI_QUAT_X, 0.0);
-      o.set(mrpt::obs::IMU_ORI_QUAT_Y, std::sin(-pitch / 2));
-      o.set(mrpt::obs::IMU_ORI_QUAT_Z, 0.0);
-      o.set(mrpt::obs::IMU_ORI_QUAT_W, std::cos(-pitch / 2));
+      for (const auto& f : layout.imu) o.set(f.index, f.write(m));
     }
   }
   return idx;
@@ -522,6 +450,7 @@ bool MessageAssembler::add(const mrpt::obs::CObservation& obs, Message* out, std
     return false;
   }
   const auto& spec = labels()[static_cast<std::size_t>(li)];
+  const auto& layout = layouts()[static_cast<std::size_t>(li)];
   const auto& idx = topicLabels(spec.topic);
   std::uint32_t bit = 0;
   for (std::size_t i = 0; i < idx.size(); ++i)
@@ -541,18 +470,20 @@ bool MessageAssembler::add(const mrpt::obs::CObservation& obs, Message* out, std
       ++unknown_;
       return false;
     }
-    fromChannels(spec.label, o->AIN_double.data(), &p.msg);
-  } else if (spec.label == "imu") {
+    const double* channel = o->AIN_double.data();
+    for (const auto& f : layout.channels) {
+      f.read(channel, &p.msg);
+      channel += f.columns.size();
+    }
+  } else {
     const auto* o = dynamic_cast<const CObservationIMU*>(&obs);
     if (!o) {
       ++unknown_;
       return false;
     }
-    auto& s = std::get<msg::SensorData>(p.msg);
-    s.gyro_pitch_rate(-o->rawMeasurements[mrpt::obs::IMU_WY]);
-    s.accel()[0] = o->rawMeasurements[mrpt::obs::IMU_X_ACC];
-    s.accel()[1] = o->rawMeasurements[mrpt::obs::IMU_Z_ACC];
-  }  // base_est: a derived view; est_q/est_qd carry the values
+    for (const auto& f : layout.imu)
+      if (f.read) f.read(o->rawMeasurements[f.index], &p.msg);
+  }
   p.seen |= bit;
   if (p.seen != (1u << idx.size()) - 1u) return false;
   p.active = false;
@@ -573,12 +504,8 @@ bool observationValues(const mrpt::obs::CObservation& obs, int label_index, std:
   }
   const auto* o = dynamic_cast<const CObservationIMU*>(&obs);
   if (!o) return false;
-  static const std::map<std::string, mrpt::obs::TIMUDataIndex> fields = {
-      {"IMU_WY", mrpt::obs::IMU_WY},       {"IMU_X_ACC", mrpt::obs::IMU_X_ACC}, {"IMU_Z_ACC", mrpt::obs::IMU_Z_ACC},
-      {"IMU_X", mrpt::obs::IMU_X},         {"IMU_Z", mrpt::obs::IMU_Z},         {"IMU_PITCH", mrpt::obs::IMU_PITCH},
-      {"IMU_X_VEL", mrpt::obs::IMU_X_VEL}, {"IMU_Z_VEL", mrpt::obs::IMU_Z_VEL}, {"IMU_ORI_QUAT_W", mrpt::obs::IMU_ORI_QUAT_W},
-      {"IMU_ORI_QUAT_Y", mrpt::obs::IMU_ORI_QUAT_Y}};
-  for (const auto& c : spec.columns) values->push_back(o->rawMeasurements[fields.at(c)]);
+  for (const auto& f : layouts()[static_cast<std::size_t>(label_index)].imu)
+    if (!f.column.empty()) values->push_back(o->rawMeasurements[f.index]);
   return true;
 }
 

@@ -6,8 +6,8 @@
 //   diagnostics and events; CObservationIMU for the torso IMU (`imu`) and, as a derived "virtual INS" view,
 //   the estimated floating base (`base_est`).
 // Observation timestamps are the simulator's clock: time_base_unix_ns + stamp_ns (100 ns resolution).
-// Only this file knows the channel layout: the recorder, replay and export all go through it, so the
-// reader and writer cannot disagree. Never reorder channels without bumping kSchemaVersion.
+// Only rawlog_format.cpp knows the channel layout, as one table per label from which the writer, the reader
+// and the column names all follow: the recorder, replay and export go through it, so they cannot disagree. Never reorder channels without bumping kSchemaVersion.
 #include <mrpt/obs/CObservation.h>
 
 #include <array>

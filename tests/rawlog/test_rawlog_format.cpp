@@ -707,3 +707,121 @@ TEST(RawlogBadInput, ExportOutputFolderErrorsAreOneLineAndExit2) {
   }
   EXPECT_EQ(fs::file_size(dir.file("existing.txt")), 13u) << "the existing file was touched";
 }
+
+// The channel order on disk, written out by hand here (not from the label tables in rawlog_format.cpp), so that
+// a reordered table entry fails: every channel of these labels holds a distinct value.
+namespace {
+std::vector<double> channelsOf(const Message& m, const std::string& label) {
+  ObservationEncoder enc;
+  enc.encode(m, 1'700'000'000'000'000'000LL);
+  std::vector<double> v;
+  EXPECT_TRUE(observationValues(enc.observation(labelIndex(label)), labelIndex(label), &v));
+  return v;
+}
+}  // namespace
+
+TEST(RawlogFormat, ChannelOrderOnDiskIsPinned) {
+  msg::WbcDiagnostics d;
+  d.tick(7);
+  d.solve_time_us(1.5);
+  d.tick_time_us(2.5);
+  d.iterations(3);
+  d.status(4);
+  d.active_constraints(5);
+  d.slack_norm(6.5);
+  d.task_error({11, 12, 13, 14, 15, 16});
+  d.lti({21, 22});
+  d.raci({31, 32});
+  d.safety_events(41);
+  d.holding(true);
+  d.damping(false);
+  EXPECT_EQ(channelsOf(d, "wbc_diag"),
+            (std::vector<double>{7, 1.5, 2.5, 3, 4, 5, 6.5, 11, 12, 13, 14, 15, 16, 21, 22, 31, 32, 41, 1, 0}));
+
+  msg::SensorData s;
+  s.tick(9);
+  s.actuated_pos({1, 3, 5, 7});
+  s.passive_pos({2, 4, 6, 8});
+  s.gyro_pitch_rate(0.25);
+  s.accel({0.5, 9.75});
+  EXPECT_EQ(channelsOf(s, "joint_q"), (std::vector<double>{9, 1, 2, 3, 4, 5, 6, 7, 8}));
+  EXPECT_EQ(channelsOf(s, "imu"), (std::vector<double>{-0.25, 0.5, 9.75}));
+
+  msg::Reference r;
+  r.tick(3);
+  r.step_index(4);
+  r.phase(0.5);
+  r.stance_leg(-1);
+  r.foot_in_stance({true, false});
+  r.base_z({1, 2, 3});
+  r.base_pitch({4, 5, 6});
+  r.foot_pos({7, 8, 9, 10});
+  r.foot_vel({11, 12, 13, 14});
+  r.foot_acc({15, 16, 17, 18});
+  r.base_x({19, 20, 21});
+  r.hold_base_x(true);
+  EXPECT_EQ(channelsOf(r, "plan_ref"), (std::vector<double>{3, 4, 0.5, -1, 1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12,
+                                                            13, 14, 15, 16, 17, 18, 19, 20, 21, 1}));
+
+  msg::RobotState st;
+  st.q()[0] = 0.5;
+  st.q()[1] = 0.4;
+  st.q()[2] = 0.2;
+  st.qd()[0] = 0.1;
+  st.qd()[1] = -0.1;
+  st.qd()[2] = 0.3;
+  const auto base = channelsOf(st, "base_est");
+  ASSERT_EQ(base.size(), 8u);
+  EXPECT_EQ(base[0], 0.5);
+  EXPECT_EQ(base[1], 0.4);
+  EXPECT_EQ(base[2], -0.2);
+  EXPECT_EQ(base[3], 0.1);
+  EXPECT_EQ(base[4], -0.1);
+  EXPECT_EQ(base[5], -0.3);
+  EXPECT_DOUBLE_EQ(base[6], std::cos(-0.1));
+  EXPECT_DOUBLE_EQ(base[7], std::sin(-0.1));
+
+  msg::Disturbance p;
+  p.seq(12);
+  p.impulse(5.5);
+  p.trigger(1);
+  p.time_s(4.25);
+  p.leg(0);
+  EXPECT_EQ(channelsOf(p, "disturbance"), (std::vector<double>{12, 5.5, 1, 4.25, 0}));
+}
+
+// Every label: the columns named in the metadata and CSV header are exactly the channels written and read.
+TEST(RawlogFormat, EveryLabelReadsBackWhatItWrote) {
+  std::mt19937_64 g(17);
+  auto msgs = tickMessages(5, g);
+  msg::OperatorCommand o;
+  o.seq(3), o.z_cmd(0.43), o.v_cmd(0.1), o.mode(2);
+  msg::Disturbance d;
+  d.seq(4), d.impulse(5.0), d.trigger(1), d.time_s(2.5), d.leg(1);
+  msg::ConfigChange c;
+  c.seq(5), c.applied(true), c.target(msg::CONFIG_TARGET_WBC), c.at_s(2.0), c.tick(2000), c.count(1);
+  c.number({100.0, 0.0});
+  std::snprintf(c.key().data(), c.key().size(), "%s", "gains.base_z.kp");
+  msgs.insert(msgs.end(), {o, d, c});
+  for (const auto& m : msgs) {
+    ObservationEncoder enc;
+    MessageAssembler asmb(0);
+    Message back;
+    std::int64_t t = 0;
+    bool complete = false;
+    for (int li : enc.encode(m, 1'000'000)) {
+      std::vector<double> v;
+      ASSERT_TRUE(observationValues(enc.observation(li), li, &v));
+      EXPECT_EQ(v.size(), labels()[static_cast<std::size_t>(li)].columns.size()) << labels()[static_cast<std::size_t>(li)].label;
+      complete = asmb.add(enc.observation(li), &back, &t);
+    }
+    ASSERT_TRUE(complete) << topicName(topicOf(m));
+    ObservationEncoder again;
+    for (int li : again.encode(back, t)) {
+      std::vector<double> a, b;
+      observationValues(enc.observation(li), li, &a);
+      observationValues(again.observation(li), li, &b);
+      EXPECT_EQ(a, b) << labels()[static_cast<std::size_t>(li)].label;
+    }
+  }
+}

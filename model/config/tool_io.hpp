@@ -6,17 +6,9 @@
 #include <string>
 
 #include "model/config/install_layout.hpp"  // the tools' data paths (configuration, scripts)
+#include "model/config/json_writer.hpp"        // every --json and summary
 
 namespace mft::config {
-
-// The text of a JSON string without the quotes: '"', '\\' and every control character escaped (RFC 8259),
-// so that a scenario name or a file name with a tab or an ESC still gives valid JSON. Bytes >= 0x80 pass.
-std::string jsonEscape(const std::string& text);
-// jsonEscape with the quotes.
-std::string jsonString(const std::string& text);
-// A number (%g with this many significant digits), or null when it is not finite (NaN and infinities are
-// not JSON).
-std::string jsonNumber(double value, int significant_digits = 10);
 
 constexpr int kExitIoOrInput = 2;
 constexpr int kExitInternal = 1;

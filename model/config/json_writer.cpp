@@ -1,0 +1,114 @@
+#include "model/config/json_writer.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+
+namespace mft::config {
+
+std::string jsonEscape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size() + 8);
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      case '\b': out += "\\b"; break;
+      case '\f': out += "\\f"; break;
+      default:
+        if (u < 0x20 || u == 0x7f) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(u));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+std::string jsonString(const std::string& text) { return "\"" + jsonEscape(text) + "\""; }
+
+std::string jsonNumber(double value, int significant_digits) {
+  if (!std::isfinite(value)) return "null";
+  char buf[64];
+  if (significant_digits != kRoundTrip) {
+    std::snprintf(buf, sizeof buf, "%.*g", significant_digits, value);
+    return buf;
+  }
+  for (int digits = 15; digits <= 17; ++digits) {
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    if (std::strtod(buf, nullptr) == value) break;
+  }
+  return buf;
+}
+
+std::string jsonFixed(double value, int decimals) {
+  if (!std::isfinite(value)) return "null";
+  char buf[352];  // %.Nf of 1e308 has 309 digits before the point
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  return buf;
+}
+
+void JsonWriter::beforeValue() {
+  if (!open_.empty() && open_.back() == '{' && !after_key_)
+    throw std::logic_error("JsonWriter: a value inside an object needs a key");
+  if (open_.empty() && !out_.empty()) throw std::logic_error("JsonWriter: a second top-level value");
+  if (!after_key_ && !first_) out_ += ", ";
+  after_key_ = false;
+  first_ = false;
+}
+
+JsonWriter& JsonWriter::open(char bracket) {
+  beforeValue();
+  out_ += bracket;
+  open_.push_back(bracket);
+  first_ = true;
+  return *this;
+}
+JsonWriter& JsonWriter::close(char bracket) {
+  if (open_.empty() || open_.back() != bracket || after_key_)
+    throw std::logic_error(std::string("JsonWriter: unbalanced close of ") + bracket);
+  open_.pop_back();
+  out_ += bracket == '{' ? '}' : ']';
+  first_ = false;
+  return *this;
+}
+JsonWriter& JsonWriter::key(std::string_view name) {
+  if (open_.empty() || open_.back() != '{' || after_key_) throw std::logic_error("JsonWriter: a key outside an object");
+  if (!first_) out_ += ", ";
+  out_ += jsonString(std::string(name));
+  out_ += ": ";
+  after_key_ = true;
+  return *this;
+}
+JsonWriter& JsonWriter::value(double v, int significant_digits) { return raw(jsonNumber(v, significant_digits)); }
+JsonWriter& JsonWriter::fixed(double v, int decimals) { return raw(jsonFixed(v, decimals)); }
+JsonWriter& JsonWriter::value(bool v) { return raw(v ? "true" : "false"); }
+JsonWriter& JsonWriter::value(std::string_view text) { return raw(jsonString(std::string(text))); }
+JsonWriter& JsonWriter::null() { return raw("null"); }
+JsonWriter& JsonWriter::raw(std::string_view json) {
+  beforeValue();
+  out_ += json;
+  return *this;
+}
+JsonWriter& JsonWriter::numbers(std::string_view name, const double* v, std::size_t n, int significant_digits) {
+  key(name);
+  beginArray();
+  for (std::size_t i = 0; i < n; ++i) value(v[i], significant_digits);
+  return endArray();
+}
+
+const std::string& JsonWriter::str() const {
+  if (!open_.empty()) throw std::logic_error("JsonWriter: an object or array is still open");
+  return out_;
+}
+
+}  // namespace mft::config

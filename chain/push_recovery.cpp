@@ -6,25 +6,12 @@
 #include <limits>
 #include <stdexcept>
 
+#include "model/config/json_writer.hpp"
+
 namespace mft::chain {
 namespace {
 
-// Fixed decimals (JSON has no NaN: null).
-std::string num(double v, int decimals = 5) {
-  if (!std::isfinite(v)) return "null";
-  char b[48];
-  std::snprintf(b, sizeof b, "%.*f", decimals, v);
-  return b;
-}
-
-std::string escape(const std::string& in) {
-  std::string out;
-  for (char c : in) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out;
-}
+constexpr int kDecimals = 5;  // the summaries' default for metres, radians and speeds
 
 }  // namespace
 
@@ -48,25 +35,28 @@ const char* toString(RecoveryOutcome o) {
 }
 
 std::string RecoveryCriteria::toJson() const {
-  return std::string("{\"rule\": \"") + toString(rule) + "\", \"window_s\": " + num(window_s, 3) +
-         ", \"max_speed_mps\": " + num(max_speed_mps, 4) + ", \"height_band_m\": " + num(height_band_m, 4) +
-         ", \"max_pitch_rad\": " + num(max_pitch_rad, 4) + ", \"min_touchdowns\": " + std::to_string(min_touchdowns) +
-         "}";
+  config::JsonWriter w;
+  w.beginObject().field("rule", toString(rule)).fixedField("window_s", window_s, 3);
+  w.fixedField("max_speed_mps", max_speed_mps, 4).fixedField("height_band_m", height_band_m, 4);
+  w.fixedField("max_pitch_rad", max_pitch_rad, 4).field("min_touchdowns", min_touchdowns);
+  return w.endObject().str();
 }
 
 std::string BaseWindow::toJson() const {
   if (empty) return "null";
-  return "{\"from_s\": " + num(from_s, 4) + ", \"to_s\": " + num(to_s, 4) +
-         ", \"mean_speed_mps\": " + num(mean_speed_mps) + ", \"mean_base_height_m\": " + num(mean_base_height_m) +
-         ", \"min_base_height_m\": " + num(min_base_height_m) + ", \"max_base_height_m\": " + num(max_base_height_m) +
-         ", \"max_abs_pitch_rad\": " + num(max_abs_pitch_rad) + ", \"touchdowns\": " + std::to_string(touchdowns) + "}";
+  config::JsonWriter w;
+  w.beginObject().fixedField("from_s", from_s, 4).fixedField("to_s", to_s, 4);
+  w.fixedField("mean_speed_mps", mean_speed_mps, kDecimals).fixedField("mean_base_height_m", mean_base_height_m, kDecimals);
+  w.fixedField("min_base_height_m", min_base_height_m, kDecimals).fixedField("max_base_height_m", max_base_height_m, kDecimals);
+  w.fixedField("max_abs_pitch_rad", max_abs_pitch_rad, kDecimals).field("touchdowns", touchdowns);
+  return w.endObject().str();
 }
 
 std::string RecoveryVerdict::toJson() const {
-  return std::string("{\"recovered\": ") + (recovered ? "true" : "false") + ", \"outcome\": \"" + toString(outcome) +
-         "\", \"pushed\": " + (pushed ? "true" : "false") + ", \"no_fall\": " + (no_fall ? "true" : "false") +
-         ", \"back_to_stepping\": " + (back_to_stepping ? "true" : "false") + ", \"reason\": \"" + escape(reason) +
-         "\"}";
+  config::JsonWriter w;
+  w.beginObject().field("recovered", recovered).field("outcome", toString(outcome)).field("pushed", pushed);
+  w.field("no_fall", no_fall).field("back_to_stepping", back_to_stepping).field("reason", reason);
+  return w.endObject().str();
 }
 
 RecoveryVerdict judgeRecovery(const RecoveryRecord& r, const RecoveryCriteria& c, bool fell, double fall_time_s,
@@ -200,14 +190,21 @@ std::string RecoveryWindow::json(const RecoveryCriteria& criteria, bool fell, do
   const RecoveryRecord r = record();
   const RecoveryVerdict v = judgeRecovery(r, criteria, fell, fall_time_s, fall_reason);
   const bool p = r.impulses > 0;
-  return "{\"window_s\": " + num(r.window_s, 3) + ", \"impulses\": " + std::to_string(r.impulses) +
-         ", \"push_time_s\": " + (p ? num(r.push_time_s) : "null") + ", \"push_impulse_Ns\": " + num(r.push_impulse_Ns, 4) +
-         ", \"pre\": " + (p ? r.pre.toJson() : "null") + ", \"after\": " +
-         (p ? "{\"min_base_height_m\": " + num(r.after_min_base_height_m) + ", \"max_abs_pitch_rad\": " +
-                  num(r.after_max_abs_pitch_rad) + ", \"max_abs_speed_mps\": " + num(r.after_max_abs_speed_mps) +
-                  ", \"min_lti\": " + num(r.after_min_lti) + "}"
-            : std::string("null")) +
-         ", \"tail\": " + r.tail.toJson() + ", \"criteria\": " + criteria.toJson() + ", \"verdict\": " + v.toJson() + "}";
+  config::JsonWriter w;
+  w.beginObject().fixedField("window_s", r.window_s, 3).field("impulses", r.impulses).key("push_time_s");
+  if (p) w.fixed(r.push_time_s, kDecimals);
+  else w.null();
+  w.fixedField("push_impulse_Ns", r.push_impulse_Ns, 4).key("pre").raw(p ? r.pre.toJson() : "null").key("after");
+  if (p) {
+    w.beginObject().fixedField("min_base_height_m", r.after_min_base_height_m, kDecimals);
+    w.fixedField("max_abs_pitch_rad", r.after_max_abs_pitch_rad, kDecimals);
+    w.fixedField("max_abs_speed_mps", r.after_max_abs_speed_mps, kDecimals);
+    w.fixedField("min_lti", r.after_min_lti, kDecimals).endObject();
+  } else {
+    w.null();
+  }
+  w.key("tail").raw(r.tail.toJson()).key("criteria").raw(criteria.toJson()).key("verdict").raw(v.toJson());
+  return w.endObject().str();
 }
 
 }  // namespace mft::chain

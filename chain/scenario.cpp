@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <sstream>
 
 #include "model/config/profiles.hpp"
 #include "model/config/strict_yaml.hpp"
@@ -132,31 +131,35 @@ std::vector<std::string> activateRunProfiles(const std::string& config_dir, cons
 }
 
 std::string profilesJson(const std::vector<std::string>& names) {
-  std::string o = "[";
-  for (std::size_t i = 0; i < names.size(); ++i) o += (i ? ", \"" : "\"") + names[i] + "\"";
-  return o + "]";
+  config::JsonWriter w;
+  w.beginArray();
+  for (const auto& name : names) w.value(name);
+  return w.endArray().str();
 }
 
 std::string Scenario::toJson() const {
-  const auto esc = config::jsonEscape;
-  std::ostringstream o;
-  o.precision(17);
-  o << "{\"name\": \"" << esc(name) << "\", \"file\": \"" << esc(source_file) << "\", \"duration_s\": " << duration_s
-    << ", \"controller\": \"" << controller << "\", \"estimator\": \"" << estimator << "\", \"terrain\": \""
-    << esc(terrain) << "\", \"initial_base_height_m\": " << initial_base_height_m
-    << ", \"initial_stance_width_m\": " << initial_stance_width_m
-    << ", \"fall\": {\"base_height_below_m\": " << fall_base_height_m << ", \"pitch_beyond_rad\": " << fall_pitch_rad
-    << "}, \"recovery\": " << recovery.toJson() << ", \"commands\": [";
-  for (std::size_t i = 0; i < commands.size(); ++i)
-    o << (i ? ", " : "") << "{\"at_s\": " << commands[i].at_s << ", \"mode\": \"" << toString(commands[i].mode)
-      << "\", \"z_cmd_m\": " << commands[i].z_cmd_m << ", \"v_cmd_mps\": " << commands[i].v_cmd_mps << "}";
-  o << "], \"pushes\": [";
-  for (std::size_t i = 0; i < pushes.size(); ++i)
-    o << (i ? ", " : "") << "{\"impulse_Ns\": " << pushes[i].impulse_Ns << ", \"at_s\": " << pushes[i].at_s
-      << ", \"at_liftoff\": "
-      << (pushes[i].at_liftoff_leg < 0 ? "null" : (pushes[i].at_liftoff_leg == 0 ? "\"right\"" : "\"left\"")) << "}";
-  o << "], \"profiles\": " << profilesJson(profiles) << "}";
-  return o.str();
+  constexpr int kDigits = 17;  // every value as loaded
+  config::JsonWriter w;
+  w.beginObject().field("name", name).field("file", source_file).field("duration_s", duration_s, kDigits);
+  w.field("controller", controller).field("estimator", estimator).field("terrain", terrain);
+  w.field("initial_base_height_m", initial_base_height_m, kDigits);
+  w.field("initial_stance_width_m", initial_stance_width_m, kDigits);
+  w.key("fall").beginObject().field("base_height_below_m", fall_base_height_m, kDigits);
+  w.field("pitch_beyond_rad", fall_pitch_rad, kDigits).endObject();
+  w.key("recovery").raw(recovery.toJson()).key("commands").beginArray();
+  for (const auto& c : commands) {
+    w.beginObject().field("at_s", c.at_s, kDigits).field("mode", toString(c.mode));
+    w.field("z_cmd_m", c.z_cmd_m, kDigits).field("v_cmd_mps", c.v_cmd_mps, kDigits).endObject();
+  }
+  w.endArray().key("pushes").beginArray();
+  for (const auto& p : pushes) {
+    w.beginObject().field("impulse_Ns", p.impulse_Ns, kDigits).field("at_s", p.at_s, kDigits).key("at_liftoff");
+    if (p.at_liftoff_leg < 0) w.null();
+    else w.value(p.at_liftoff_leg == 0 ? "right" : "left");
+    w.endObject();
+  }
+  w.endArray().key("profiles").raw(profilesJson(profiles));
+  return w.endObject().str();
 }
 
 }  // namespace mft::chain

@@ -99,6 +99,11 @@ JsonWriter& JsonWriter::raw(std::string_view json) {
   out_ += json;
   return *this;
 }
+JsonWriter& JsonWriter::numbers(std::initializer_list<double> v, int significant_digits) {
+  beginArray();
+  for (const double x : v) value(x, significant_digits);
+  return endArray();
+}
 JsonWriter& JsonWriter::numbers(std::string_view name, const double* v, std::size_t n, int significant_digits) {
   key(name);
   beginArray();

@@ -4,6 +4,7 @@
 // that are not finite are written as null (NaN and infinities are not JSON). Single line, ", " between items.
 // Not for the control loop (it allocates): summaries are written at exit.
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -63,7 +64,8 @@ class JsonWriter {
     key(name);
     return fixed(v, decimals);
   }
-  // An array of numbers.
+  // An array of numbers (as a value, or as the field `name`).
+  JsonWriter& numbers(std::initializer_list<double> v, int significant_digits = kRoundTrip);
   JsonWriter& numbers(std::string_view name, const double* v, std::size_t n, int significant_digits = kRoundTrip);
 
   // The text; throws std::logic_error if an object or array is still open.

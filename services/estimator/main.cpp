@@ -86,12 +86,12 @@ static int toolMain(int argc, char** argv) {
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
-  char head[256];
-  std::snprintf(head, sizeof head, "{\"service\": \"mft-estimator\", \"mode\": \"%s\", \"ticks\": %llu, \"last_tick\": %llu, ",
-                ctx.scenario().estimator.c_str(), static_cast<unsigned long long>(join.ticks()),
-                static_cast<unsigned long long>(join.lastTick()));
-  ctx.writeSummary(std::string(head) + join.countsJson() + ", \"deadline_misses\": " +
-                   std::to_string(sensor_reader.requestedDeadlineMisses()) + ", \"update_time_us\": " + update_us.json() + "}");
+  config::JsonWriter w;
+  w.beginObject().field("service", "mft-estimator").field("mode", ctx.scenario().estimator);
+  w.field("ticks", join.ticks()).field("last_tick", join.lastTick());
+  join.writeCounts(w);
+  w.field("deadline_misses", sensor_reader.requestedDeadlineMisses()).key("update_time_us").raw(update_us.json());
+  ctx.writeSummary(w.endObject().str());
   return 0;
 }
 

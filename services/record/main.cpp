@@ -137,10 +137,11 @@ static int toolMain(int argc, char** argv) {
               static_cast<unsigned long long>(s.objects), static_cast<unsigned long long>(s.topics[0].written),
               static_cast<unsigned long long>(s.topics[0].dropped_queue + s.topics[0].tick_gaps),
               static_cast<double>(s.compressed_bytes) / 1e6, s.pieces.size(), s.pieces.empty() ? "" : s.pieces.front().c_str());
-  services::writeSummaryFile(cli.get("summary"), "{\"service\": \"mft-record\", \"file\": \"" + opt.output + "\", \"mode\": \"" +
-                                                     mode + "\", \"cpu_s\": " + cpu_json + ", " +
-                                                     services::pollJson(priority.starvationFallbacks()) + ", " +
-                                                     recorder.summaryJson() + "}", "mft-record");
+  config::JsonWriter w;
+  w.beginObject().field("service", "mft-record").field("file", opt.output).field("mode", mode).key("cpu_s").raw(cpu_json);
+  services::writePollFields(w, priority.starvationFallbacks());
+  recorder.writeSummary(w);
+  services::writeSummaryFile(cli.get("summary"), w.endObject().str(), "mft-record");
   return s.error.empty() ? 0 : 1;
 }
 

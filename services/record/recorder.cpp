@@ -322,44 +322,38 @@ RecorderStats Recorder::stats() const {
   return stats_;
 }
 
-std::string Recorder::summaryJson() const {
+void Recorder::writeSummary(config::JsonWriter& w) const {
   const RecorderStats s = stats();
-  std::ostringstream j;
   std::uint64_t dropped = 0, gaps = 0;
-  j << "\"topics\": {";
+  w.key("topics").beginObject();
   for (std::size_t i = 0; i < kNumTopics; ++i) {
     const auto& c = s.topics[i];
     dropped += c.dropped_queue;
     if (hasTick(static_cast<Topic>(i))) gaps += c.tick_gaps;
-    j << (i ? ", " : "") << "\"" << topicName(static_cast<Topic>(i)) << "\": {\"received\": " << c.received
-      << ", \"written\": " << c.written << ", \"dropped_queue\": " << c.dropped_queue << ", \"repeated\": " << c.repeated
-      << ", \"tick_gaps\": " << c.tick_gaps << ", \"out_of_order\": " << c.out_of_order
-      << ", \"first\": " << (c.any ? static_cast<long long>(c.first_tick) : -1)
-      << ", \"last\": " << (c.any ? static_cast<long long>(c.last_tick) : -1) << "}";
+    w.key(topicName(static_cast<Topic>(i))).beginObject().field("received", c.received).field("written", c.written);
+    w.field("dropped_queue", c.dropped_queue).field("repeated", c.repeated).field("tick_gaps", c.tick_gaps);
+    w.field("out_of_order", c.out_of_order).field("first", c.any ? static_cast<long long>(c.first_tick) : -1LL);
+    w.field("last", c.any ? static_cast<long long>(c.last_tick) : -1LL).endObject();
   }
-  j << "}, \"labels\": {";
-  for (std::size_t i = 0; i < labels().size(); ++i)
-    j << (i ? ", " : "") << "\"" << labels()[i].label << "\": " << s.label_objects[i];
+  w.endObject().key("labels").beginObject();
+  for (std::size_t i = 0; i < labels().size(); ++i) w.field(labels()[i].label, s.label_objects[i]);
+  w.endObject();
   const double sim_s = s.first_stamp_ns >= 0 ? static_cast<double>(s.last_stamp_ns - s.first_stamp_ns) * 1e-9 + 1e-3 : 0.0;
-  char buf[1200];
-  std::snprintf(buf, sizeof buf,
-                "}, \"dropped_samples\": %llu, \"dropped_in_queue\": %llu, \"tick_gaps\": %llu, \"objects\": %llu, "
-                "\"uncompressed_bytes\": %llu, \"file_bytes\": %llu, \"recorded_sim_s\": %.3f, \"mb_per_sim_minute\": %.3f, "
-                "\"writer_busy_s\": %.3f, \"writer_objects_per_busy_s\": %.0f, \"writer_ticks_per_busy_s\": %.0f, "
-                "\"max_queue_depth\": %zu, \"queue_capacity\": %zu, \"flushes\": %llu, \"max_unflushed_ms\": %.1f, "
-                "\"flushed_sim_s\": %.3f, \"dropped_after_error\": %llu, \"error\": \"%s\"",
-                static_cast<unsigned long long>(dropped + gaps), static_cast<unsigned long long>(dropped),
-                static_cast<unsigned long long>(gaps), static_cast<unsigned long long>(s.objects),
-                static_cast<unsigned long long>(s.uncompressed_bytes), static_cast<unsigned long long>(s.compressed_bytes),
-                sim_s, sim_s > 0 ? static_cast<double>(s.compressed_bytes) / 1e6 / (sim_s / 60.0) : 0.0, s.writer_busy_s,
-                s.writer_busy_s > 0 ? static_cast<double>(s.objects) / s.writer_busy_s : 0.0,
-                s.writer_busy_s > 0 ? static_cast<double>(s.topics[0].written) / s.writer_busy_s : 0.0,
-                s.max_queue_depth, opt_.queue_capacity, static_cast<unsigned long long>(s.flushes),
-                s.max_flush_interval_s * 1e3, static_cast<double>(s.flushed_stamp_ns) * 1e-9,
-                static_cast<unsigned long long>(s.dropped_after_error), config::jsonEscape(s.error).c_str());
-  std::string pieces = ", \"pieces\": [";
-  for (std::size_t i = 0; i < s.pieces.size(); ++i) pieces += (i ? ", \"" : "\"") + s.pieces[i] + "\"";
-  return j.str() + buf + pieces + "]";
+  w.field("dropped_samples", dropped + gaps).field("dropped_in_queue", dropped).field("tick_gaps", gaps);
+  w.field("objects", s.objects).field("uncompressed_bytes", s.uncompressed_bytes).field("file_bytes", s.compressed_bytes);
+  w.fixedField("recorded_sim_s", sim_s, 3);
+  w.fixedField("mb_per_sim_minute", sim_s > 0 ? static_cast<double>(s.compressed_bytes) / 1e6 / (sim_s / 60.0) : 0.0, 3);
+  w.fixedField("writer_busy_s", s.writer_busy_s, 3);
+  w.fixedField("writer_objects_per_busy_s", s.writer_busy_s > 0 ? static_cast<double>(s.objects) / s.writer_busy_s : 0.0, 0);
+  w.fixedField("writer_ticks_per_busy_s",
+               s.writer_busy_s > 0 ? static_cast<double>(s.topics[0].written) / s.writer_busy_s : 0.0, 0);
+  w.field("max_queue_depth", s.max_queue_depth).field("queue_capacity", opt_.queue_capacity).field("flushes", s.flushes);
+  w.fixedField("max_unflushed_ms", s.max_flush_interval_s * 1e3, 1);
+  w.fixedField("flushed_sim_s", static_cast<double>(s.flushed_stamp_ns) * 1e-9, 3);
+  w.field("dropped_after_error", s.dropped_after_error).field("error", s.error);
+  w.key("pieces").beginArray();
+  for (const auto& piece : s.pieces) w.value(piece);
+  w.endArray();
 }
 
 }  // namespace mft::rawlog

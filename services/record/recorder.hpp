@@ -16,6 +16,7 @@
 #include <tuple>
 #include <vector>
 
+#include "model/config/json_writer.hpp"
 #include "services/record/rawlog_format.hpp"
 
 namespace mft::rawlog {
@@ -74,7 +75,7 @@ class Recorder {
   int writerThreadId() const { return writer_tid_.load(); }
   std::uint64_t newestStampNs() const { return newest_stamp_.load(); }
   // JSON object with the counters (for the service summary).
-  std::string summaryJson() const;
+  void writeSummary(config::JsonWriter& w) const;
 
  private:
   struct Sample {

@@ -100,24 +100,20 @@ std::string threadCpuJson() {
     }
     by_name[line.substr(open + 1, close - open - 1)] += (utime + stime) / tick;
   }
-  std::string j = "{";
+  config::JsonWriter w;
+  w.beginObject();
   double total = 0;
   for (const auto& [name, s] : by_name) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "%s\"%s\": %.3f", j.size() > 1 ? ", " : "", name.c_str(), s);
-    j += buf;
+    w.fixedField(name, s, 3);
     total += s;
   }
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%s\"total\": %.3f}", j.size() > 1 ? ", " : "", total);
-  return j + buf;
+  return w.fixedField("total", total, 3).endObject().str();
 }
 
-std::string pollJson(int starvation_fallbacks) {
+void writePollFields(config::JsonWriter& w, int starvation_fallbacks) {
   const auto& st = PollingUdpTransport::lastStats();
-  return "\"receive_polls\": " + std::to_string(st.polls.load()) + ", \"polled_datagrams\": " +
-         std::to_string(st.datagrams.load()) + ", \"max_datagrams_per_poll\": " + std::to_string(st.max_datagrams_per_poll.load()) +
-         ", \"idle_starvation_fallbacks\": " + std::to_string(starvation_fallbacks);
+  w.field("receive_polls", st.polls.load()).field("polled_datagrams", st.datagrams.load());
+  w.field("max_datagrams_per_poll", st.max_datagrams_per_poll.load()).field("idle_starvation_fallbacks", starvation_fallbacks);
 }
 
 }  // namespace mft::services

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "model/config/json_writer.hpp"
 #include "services/record/recorder.hpp"
 
 namespace mft::services {
@@ -36,7 +37,8 @@ class BackgroundPolicy {
 // CPU seconds used so far by this process's threads, summed by thread name (the DDS receive threads versus the
 // writer): what the recorder costs the machine, independent of how busy the machine is.
 std::string threadCpuJson();
-// What the polling receive path did (all zero with --poll-us 0), and the starvation fallbacks.
-std::string pollJson(int starvation_fallbacks);
+// What the polling receive path did (all zero with --poll-us 0), and the starvation fallbacks: fields of the
+// summary being written.
+void writePollFields(config::JsonWriter& w, int starvation_fallbacks);
 
 }  // namespace mft::services

@@ -2,9 +2,10 @@
 // Per-tick timing statistics for service summaries: mean, p50, p99 and max over a preallocated sample buffer
 // (no allocation while recording; beyond capacity only mean and max keep counting).
 #include <algorithm>
-#include <cstdio>
 #include <string>
 #include <vector>
+
+#include "model/config/json_writer.hpp"
 
 namespace mft::services {
 
@@ -30,10 +31,10 @@ class LatencyStats {
   }
   // {"mean": .., "p50": .., "p99": .., "max": .., "count": ..}
   std::string json() const {
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "{\"mean\": %.3f, \"p50\": %.3f, \"p99\": %.3f, \"max\": %.3f, \"count\": %zu}", mean(),
-                  percentile(0.5), percentile(0.99), max(), count_);
-    return buf;
+    config::JsonWriter w;
+    w.beginObject().fixedField("mean", mean(), 3).fixedField("p50", percentile(0.5), 3);
+    w.fixedField("p99", percentile(0.99), 3).fixedField("max", max(), 3).field("count", count_);
+    return w.endObject().str();
   }
 
  private:

@@ -28,23 +28,6 @@ bool writeTuningStatus(const std::string& path, const std::string& json) {
   return !ec;
 }
 
-std::string jsonEscape(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 std::string configTextInForce(const std::string& path) {
   std::ifstream in(path);
   std::stringstream text;

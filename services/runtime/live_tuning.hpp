@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "model/config/json_writer.hpp"
 #include "idl/msg_pubsub.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/topic_io.hpp"
@@ -33,7 +34,6 @@ namespace mft::services {
 std::string tuningStatusFile(const std::string& summary_file);
 // Writes the status file (never half-written); returns false on failure.
 bool writeTuningStatus(const std::string& path, const std::string& json);
-std::string jsonEscape(const std::string& s);
 // The text of configuration file `path` as the loaders read it (the active profiles applied). Throws
 // config::ConfigError when it cannot be read.
 std::string configTextInForce(const std::string& path);
@@ -123,8 +123,9 @@ class LiveTuning {
     return applied_;
   }
   std::string summaryJson() const {
-    return "{\"received\": " + std::to_string(received()) + ", \"rejected\": " + std::to_string(rejected()) +
-           ", \"applied\": " + std::to_string(applied()) + "}";
+    config::JsonWriter w;
+    w.beginObject().field("received", received()).field("rejected", rejected()).field("applied", applied());
+    return w.endObject().str();
   }
 
  private:
@@ -215,12 +216,10 @@ class LiveTuning {
                   static_cast<unsigned long long>(p.record.seq()), static_cast<unsigned long long>(p.record.tick()),
                   time_s, p.record.key().data(), p.value_text.data(), p.previous_text.data());
       std::fflush(stdout);
-      char buf[96];
-      std::snprintf(buf, sizeof buf, "%.6f", time_s);
-      history_ += std::string(history_.empty() ? "" : ", ") + "{\"seq\": " + std::to_string(p.record.seq()) +
-                  ", \"key\": " + jsonEscape(text(p.record.key())) + ", \"value\": " + jsonEscape(text(p.value_text)) +
-                  ", \"previous\": " + jsonEscape(text(p.previous_text)) + ", \"tick\": " +
-                  std::to_string(p.record.tick()) + ", \"time_s\": " + buf + "}";
+      config::JsonWriter change;
+      change.beginObject().field("seq", p.record.seq()).field("key", text(p.record.key()));
+      change.field("value", text(p.value_text)).field("previous", text(p.previous_text)).field("tick", p.record.tick());
+      history_.push_back(change.fixedField("time_s", time_s, 6).endObject().str());
       writeStatus();
       lock.lock();
     }
@@ -228,7 +227,10 @@ class LiveTuning {
 
   void writeStatus() {
     if (status_file_.empty()) return;
-    writeTuningStatus(status_file_, std::string("{\"service\": \"") + service_ + "\", \"applied\": [" + history_ + "]}");
+    config::JsonWriter w;
+    w.beginObject().field("service", service_).key("applied").beginArray();
+    for (const auto& change : history_) w.raw(change);
+    writeTuningStatus(status_file_, w.endArray().endObject().str());
   }
 
   std::string current_text_;  // reader-thread only: the configuration with every accepted change
@@ -250,7 +252,7 @@ class LiveTuning {
   double now_s_ = -std::numeric_limits<double>::infinity();
   std::atomic<std::uint64_t> received_{0}, rejected_{0};
   bool stop_ = false;
-  std::string history_;  // worker-thread only
+  std::vector<std::string> history_;  // worker-thread only: each applied change as JSON
   std::thread worker_;
 };
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <string>
 
+#include "model/config/json_writer.hpp"
 #include "services/runtime/tick_gate.hpp"
 
 namespace mft::services {
@@ -55,10 +56,9 @@ class TickJoin {
 
   std::uint64_t ticks() const { return ticks_; }
   std::uint64_t lastTick() const { return last_; }
-  // "\"refused_inputs\": N, \"refused_ticks\": N, \"new_clocks\": N"
-  std::string countsJson() const {
-    return "\"refused_inputs\": " + std::to_string(refused_inputs_) + ", \"refused_ticks\": " +
-           std::to_string(gate_.refused()) + ", \"new_clocks\": " + std::to_string(gate_.newClocks());
+  // refused_inputs, refused_ticks and new_clocks, as fields of the summary object being written.
+  void writeCounts(config::JsonWriter& w) const {
+    w.field("refused_inputs", refused_inputs_).field("refused_ticks", gate_.refused()).field("new_clocks", gate_.newClocks());
   }
 
  private:

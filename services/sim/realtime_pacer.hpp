@@ -40,16 +40,12 @@ class RealtimePacer {
     if (onset_late_ms_.size() < 64)
       onset_late_ms_.push_back(*std::max_element(recent_late_us_.begin(), recent_late_us_.end()) * 1e-3);
   }
-  // ", \"sim_wakeup_late_us\": {...}, \"sim_stalls\": N, \"damping_onset_sim_late_ms\": [...]"
-  std::string json() const {
-    std::string onset = "[";
-    for (std::size_t i = 0; i < onset_late_ms_.size(); ++i) {
-      char e[32];
-      std::snprintf(e, sizeof e, "%s%.3f", i ? ", " : "", onset_late_ms_[i]);
-      onset += e;
-    }
-    return ", \"sim_wakeup_late_us\": " + wakeup_late_us_.json() + ", \"sim_stalls\": " + std::to_string(stalls_) +
-           ", \"damping_onset_sim_late_ms\": " + onset + "]";
+  // sim_wakeup_late_us, sim_stalls and damping_onset_sim_late_ms, as fields of the summary being written.
+  void writeFields(config::JsonWriter& w) const {
+    w.key("sim_wakeup_late_us").raw(wakeup_late_us_.json()).field("sim_stalls", stalls_);
+    w.key("damping_onset_sim_late_ms").beginArray();
+    for (const double late_ms : onset_late_ms_) w.fixed(late_ms, 3);
+    w.endArray();
   }
 
  private:

@@ -91,22 +91,15 @@ void TopicPushes::reportApplied(const chain::SimNode& node, std::uint64_t k) {
   }
 }
 
-std::string TopicPushes::countsJson() const {
-  char buf[200];
-  std::snprintf(buf, sizeof buf, "\"disturbances_received\": %llu, \"disturbances_applied\": %llu, \"disturbances_rejected\": %llu, ",
-                static_cast<unsigned long long>(received_), static_cast<unsigned long long>(applied_count_),
-                static_cast<unsigned long long>(rejected_));
-  return buf;
+void TopicPushes::writeCounts(config::JsonWriter& w) const {
+  w.field("disturbances_received", received_).field("disturbances_applied", applied_count_);
+  w.field("disturbances_rejected", rejected_);
 }
 
-std::string TopicPushes::appliedJson() const {
-  std::string out = "[";
-  for (std::size_t i = 0; i < applied_.size(); ++i) {
-    char e[96];
-    std::snprintf(e, sizeof e, "%s[%.4f, %.4f, %.0f]", i ? ", " : "", applied_[i][0], applied_[i][1], applied_[i][2]);
-    out += e;
-  }
-  return out + "]";
+void TopicPushes::writeApplied(config::JsonWriter& w) const {
+  w.beginArray();
+  for (const auto& a : applied_) w.beginArray().fixed(a[0], 4).fixed(a[1], 4).fixed(a[2], 0).endArray();
+  w.endArray();
 }
 
 }  // namespace mft::services

@@ -10,6 +10,7 @@
 
 #include "chain/sim_node.hpp"
 #include "idl/msg_pubsub.hpp"
+#include "model/config/json_writer.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"
@@ -26,10 +27,10 @@ class TopicPushes {
   void scheduleInto(chain::SimNode& node);
   // After the step of tick k: the verdict "applied" for each request the step carried.
   void reportApplied(const chain::SimNode& node, std::uint64_t k);
-  // "disturbances_received", "disturbances_applied", "disturbances_rejected" (no braces, trailing ", ").
-  std::string countsJson() const;
-  // [[impulse N s, time s, tick], ...]
-  std::string appliedJson() const;
+  // disturbances_received, disturbances_applied, disturbances_rejected, as fields of the summary being written.
+  void writeCounts(config::JsonWriter& w) const;
+  // The array [[impulse N s, time s, tick], ...].
+  void writeApplied(config::JsonWriter& w) const;
 
  private:
   void onRequest(const msg::Disturbance& m);

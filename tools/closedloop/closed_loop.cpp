@@ -181,24 +181,36 @@ std::string ClosedLoop::recoveryJson() const { return sim_->recoveryJson(); }
 std::string RunSummary::toJson() const {
   // Window figures are null when the window holds no sample (the run ended before it began): their
   // initial values are placeholders, not measurements.
-  auto stat = [&](double v) { return window_samples ? config::jsonNumber(v, 6) : std::string("null"); };
-  std::ostringstream o;
-  o.precision(6);
-  o << "{\"fell\": " << (fell ? "true" : "false") << ", \"fall_time_s\": " << fall_time_s << ", \"fall_reason\": "
-    << config::jsonString(fall_reason) << ", \"ticks\": " << ticks << ", \"sim_time_s\": " << sim_time_s
-    << ", \"wall_time_s\": " << wall_time_s << ", \"window_s\": " << window_s
-    << ", \"window_samples\": " << window_samples << ", \"mean_base_z_m\": " << stat(mean_base_z)
-    << ", \"min_base_z_m\": " << stat(min_base_z) << ", \"max_base_z_m\": " << stat(max_base_z)
-    << ", \"rms_base_z_error_m\": " << stat(rms_base_z_error) << ", \"max_abs_base_z_error_m\": " << stat(max_abs_base_z_error)
-    << ", \"rms_pitch_rad\": " << stat(rms_pitch) << ", \"max_abs_pitch_rad\": " << stat(max_abs_pitch)
-    << ", \"average_speed_mps\": " << stat(average_speed) << ", \"estimator_rms_error\": {\"z_m\": " << stat(est_rms_z)
-    << ", \"pitch_rad\": " << stat(est_rms_pitch) << ", \"vx_mps\": " << stat(est_rms_vx) << "}"
-    << ", \"max_mft_violation\": " << stat(max_mft_violation) << ", \"min_lti\": " << stat(min_lti) << ", \"steps\": " << steps
-    << ", \"touchdowns\": {\"early\": " << early_touchdowns << ", \"late\": " << late_touchdowns
-    << ", \"forced\": " << forced_touchdowns << "}, \"non_optimal_solves\": " << non_optimal_solves
-    << ", \"safety_events\": " << safety_events << ", \"torque_clamped_ticks\": " << torque_clamped_ticks
-    << ", \"body_contact_steps\": " << body_contact_steps << "}";
-  return o.str();
+  constexpr int kDigits = 6;
+  config::JsonWriter w;
+  const auto stat = [&](const char* key, double v) {
+    w.key(key);
+    if (window_samples) w.value(v, kDigits);
+    else w.null();
+  };
+  w.beginObject().field("fell", fell).field("fall_time_s", fall_time_s, kDigits).field("fall_reason", fall_reason);
+  w.field("ticks", ticks).field("sim_time_s", sim_time_s, kDigits).field("wall_time_s", wall_time_s, kDigits);
+  w.field("window_s", window_s, kDigits).field("window_samples", window_samples);
+  stat("mean_base_z_m", mean_base_z);
+  stat("min_base_z_m", min_base_z);
+  stat("max_base_z_m", max_base_z);
+  stat("rms_base_z_error_m", rms_base_z_error);
+  stat("max_abs_base_z_error_m", max_abs_base_z_error);
+  stat("rms_pitch_rad", rms_pitch);
+  stat("max_abs_pitch_rad", max_abs_pitch);
+  stat("average_speed_mps", average_speed);
+  w.key("estimator_rms_error").beginObject();
+  stat("z_m", est_rms_z);
+  stat("pitch_rad", est_rms_pitch);
+  stat("vx_mps", est_rms_vx);
+  w.endObject();
+  stat("max_mft_violation", max_mft_violation);
+  stat("min_lti", min_lti);
+  w.field("steps", steps).key("touchdowns").beginObject().field("early", early_touchdowns).field("late", late_touchdowns);
+  w.field("forced", forced_touchdowns).endObject().field("non_optimal_solves", non_optimal_solves);
+  w.field("safety_events", safety_events).field("torque_clamped_ticks", torque_clamped_ticks);
+  w.field("body_contact_steps", body_contact_steps);
+  return w.endObject().str();
 }
 
 std::string ClosedLoop::csvHeader() {

@@ -173,8 +173,10 @@ static int toolMain(int argc, char** argv) {
              std::to_string(dump_end - dump_first) + " ticks written)");
 
   if (cli.isSet("json")) {
-    std::printf("{\"scenario\": %s, \"summary\": %s, \"recovery\": %s}\n", scenario.toJson().c_str(),
-                s.toJson().c_str(), loop->recoveryJson().c_str());
+    config::JsonWriter w;
+    w.beginObject().key("scenario").raw(scenario.toJson()).key("summary").raw(s.toJson());
+    w.key("recovery").raw(loop->recoveryJson());
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("%s (%s, %s estimator%s%s): %s after %.3f s%s%s\n", scenario.name.c_str(), scenario.controller.c_str(),
                 scenario.estimator.c_str(), scenario.profiles.empty() ? "" : ", profiles ",

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -30,23 +31,6 @@ namespace {
 // Exit statuses (also in --help).
 constexpr int kAccepted = 0, kRejected = 1, kUsage = 2, kNoStack = 3, kNotAcknowledged = 4, kNoVerdict = 5;
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 // A number with `digits` decimals (fixed) or significant digits (general, digits < 0 means -digits).
 std::string fmt(double a, int digits) {
   char buf[64];
@@ -61,6 +45,17 @@ struct Verdict {
   std::string reason;
   double waited_s = 0;  // since the command was written
 };
+
+// The verdicts as a JSON array.
+void writeVerdicts(config::JsonWriter& w, const std::vector<Verdict>& verdicts) {
+  w.beginArray();
+  for (const auto& x : verdicts) {
+    w.beginObject().field("verdict", services::verdictName(x.verdict)).field("tick", x.tick);
+    w.fixedField("time_s", static_cast<double>(x.stamp_ns) * 1e-9, 4).field("reason", x.reason);
+    w.fixedField("after_s", x.waited_s, 3).endObject();
+  }
+  w.endArray();
+}
 
 }  // namespace
 
@@ -125,22 +120,17 @@ static int runSet(const services::CommandLine& cli) {
   auto finish = [&](int code, const std::string& result, const std::string& error) {
     if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
     if (json) {
-      std::string list = "[";
+      config::JsonWriter w;
+      w.beginObject().field("command", "ConfigChange").field("domain", domain).field("at_s", at_s, 6);
+      w.field("readers_matched", matched).field("acknowledged", acknowledged).key("changes").beginArray();
       for (const auto& c : changes) {
-        std::string v = "[";
-        for (const auto& x : c.verdicts)
-          v += std::string(v.size() > 1 ? ", " : "") + "{\"verdict\": \"" + services::verdictName(x.verdict) +
-               "\", \"tick\": " + std::to_string(x.tick) + ", \"time_s\": " +
-               fmt(static_cast<double>(x.stamp_ns) * 1e-9, 4) + ", \"reason\": " + jsonString(x.reason) +
-               ", \"after_s\": " + fmt(x.waited_s, 3) + "}";
-        list += std::string(list.size() > 1 ? ", " : "") + "{\"file\": " + jsonString(c.file) + ", \"key\": " +
-                jsonString(c.key) + ", \"value\": " + jsonString(c.value) + ", \"seq\": " + std::to_string(c.msg.seq()) +
-                ", \"answered_by\": \"" + c.answerer + "\", \"verdicts\": " + v + "], \"result\": \"" + c.result + "\"}";
+        w.beginObject().field("file", c.file).field("key", c.key).field("value", c.value).field("seq", c.msg.seq());
+        w.field("answered_by", c.answerer).key("verdicts");
+        writeVerdicts(w, c.verdicts);
+        w.field("result", c.result).endObject();
       }
-      std::printf("{\"command\": \"ConfigChange\", \"domain\": %d, \"at_s\": %s, \"readers_matched\": %d, "
-                  "\"acknowledged\": %s, \"changes\": %s], \"result\": \"%s\", \"exit_code\": %d, \"error\": %s}\n",
-                  domain, fmt(at_s, -6).c_str(), matched, acknowledged ? "true" : "false", list.c_str(), result.c_str(),
-                  code, jsonString(error).c_str());
+      w.endArray().field("result", result).field("exit_code", code).field("error", error);
+      std::printf("%s\n", w.endObject().str().c_str());
     }
     std::fflush(stdout);
     return code;
@@ -323,7 +313,8 @@ static int toolMain(int argc, char** argv) {
   // The command, and how it is described in the output.
   msg::OperatorCommand command;
   msg::Disturbance push;
-  std::string topic, answerer, what_json, what_text;
+  std::string topic, answerer, what_text;
+  std::function<void(config::JsonWriter&)> write_what;  // the command's fields in the JSON
   if (has_cmd) {
     const std::string mode = cli.get("mode");
     if (mode == "stand") command.mode(msg::LOCOMOTION_STAND);
@@ -335,8 +326,9 @@ static int toolMain(int argc, char** argv) {
     command.v_cmd(cli.getDouble("speed", -100.0, 100.0));
     topic = "OperatorCommand";
     answerer = "mft-planner";
-    what_json = "\"mode\": \"" + mode + "\", \"z_cmd\": " + fmt(command.z_cmd(), -6) +
-                ", \"v_cmd\": " + fmt(command.v_cmd(), -6);
+    write_what = [mode, &command](config::JsonWriter& w) {
+      w.field("mode", mode).field("z_cmd", command.z_cmd(), 6).field("v_cmd", command.v_cmd(), 6);
+    };
     what_text = mode + ", height " + fmt(command.z_cmd(), 3) + " m, speed " + fmt(command.v_cmd(), 3) + " m/s";
   } else {
     push.seq(seq);
@@ -353,9 +345,10 @@ static int toolMain(int argc, char** argv) {
     topic = "Disturbance";
     answerer = "mft-sim";
     const bool liftoff = push.trigger() == msg::TRIGGER_AT_NEXT_LIFTOFF;
-    what_json = "\"impulse_Ns\": " + fmt(push.impulse(), -6) + ", \"trigger\": \"" +
-                (liftoff ? "at_next_liftoff" : "at_time") + "\", \"time_s\": " + fmt(push.time_s(), -6) +
-                ", \"leg\": " + std::to_string(push.leg());
+    write_what = [liftoff, &push](config::JsonWriter& w) {
+      w.field("impulse_Ns", push.impulse(), 6).field("trigger", liftoff ? "at_next_liftoff" : "at_time");
+      w.field("time_s", push.time_s(), 6).field("leg", push.leg());
+    };
     what_text = fmt(push.impulse(), 3) + " N s " +
                 (liftoff ? std::string("at the next ") + (push.leg() == 0 ? "right" : "left") + "-foot lift-off"
                          : cli.isSet("at") ? "at t = " + fmt(push.time_s(), 3) + " s" : std::string("now"));
@@ -369,17 +362,14 @@ static int toolMain(int argc, char** argv) {
   auto finish = [&](int code, const std::string& result, const std::string& error) {
     if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
     if (json) {
-      std::string v = "[";
-      for (const auto& x : verdicts)
-        v += std::string(v.size() > 1 ? ", " : "") + "{\"verdict\": \"" + services::verdictName(x.verdict) +
-             "\", \"tick\": " + std::to_string(x.tick) + ", \"time_s\": " + fmt(static_cast<double>(x.stamp_ns) * 1e-9, 4) +
-             ", \"reason\": " + jsonString(x.reason) + ", \"after_s\": " + fmt(x.waited_s, 3) + "}";
-      v += "]";
-      std::printf("{\"command\": \"%s\", \"seq\": %llu, \"domain\": %d, %s, \"readers_matched\": %d, "
-                  "\"acknowledged\": %s, \"answered_by\": \"%s\", \"verdicts\": %s, \"result\": \"%s\", \"exit_code\": %d, "
-                  "\"error\": %s}\n",
-                  topic.c_str(), static_cast<unsigned long long>(seq), domain, what_json.c_str(), matched,
-                  acknowledged ? "true" : "false", answerer.c_str(), v.c_str(), result.c_str(), code, jsonString(error).c_str());
+      config::JsonWriter w;
+      w.beginObject().field("command", topic).field("seq", seq).field("domain", domain);
+      write_what(w);
+      w.field("readers_matched", matched).field("acknowledged", acknowledged).field("answered_by", answerer);
+      w.key("verdicts");
+      writeVerdicts(w, verdicts);
+      w.field("result", result).field("exit_code", code).field("error", error);
+      std::printf("%s\n", w.endObject().str().c_str());
     }
     std::fflush(stdout);
     return code;

@@ -32,7 +32,6 @@ std::string takeFile(int* argc, char** argv) {
   return f;
 }
 
-using config::jsonEscape;
 
 struct LabelInfo {
   std::uint64_t count = 0;
@@ -173,33 +172,26 @@ int exportMain(int argc, char** argv) {
 
   const bool json = cli.isSet("json");
   if (json) {
-    std::string labels_json;
+    config::JsonWriter w;
+    w.beginObject().field("file", file).field("format", md.format).field("schema_version", md.schema_version);
+    w.field("scenario", md.scenario_name).field("mode", md.mode).field("controller", md.controller);
+    w.field("created_utc", md.created_utc).field("robot_checksum", md.robot_checksum).field("dds_naming", md.dds_naming);
+    w.field("piece", md.piece).field("time_base_unix_ns", md.time_base_unix_ns);
+    w.fixedField("first_unix_s", first_unix_ns < 0 ? 0.0 : static_cast<double>(first_unix_ns) * 1e-9, 6);
+    w.fixedField("last_unix_s", static_cast<double>(last_unix_ns) * 1e-9, 6).field("file_bytes", reader->fileSize());
+    w.field("objects", reader->objects()).field("unknown_objects", unknown).key("labels").beginObject();
     for (std::size_t i = 0; i < specs.size(); ++i) {
       const auto& in = info[i];
       if (!in.count) continue;
-      char buf[400];
-      std::snprintf(buf, sizeof buf,
-                    "%s\"%s\": {\"topic\": \"%s\", \"count\": %llu, \"first_s\": %.9f, \"last_s\": %.9f, "
-                    "\"first_tick\": %.0f, \"last_tick\": %.0f, \"tick_gaps\": %llu, \"tick_repeats\": %llu}",
-                    labels_json.empty() ? "" : ", ", specs[i].label.c_str(), rawlog::topicName(specs[i].topic),
-                    static_cast<unsigned long long>(in.count), static_cast<double>(in.first_ns) * 1e-9,
-                    static_cast<double>(in.last_ns) * 1e-9, in.first_tick, in.last_tick,
-                    static_cast<unsigned long long>(in.tick_gaps), static_cast<unsigned long long>(in.tick_repeats));
-      labels_json += buf;
+      w.key(specs[i].label).beginObject().field("topic", rawlog::topicName(specs[i].topic)).field("count", in.count);
+      w.fixedField("first_s", static_cast<double>(in.first_ns) * 1e-9, 9);
+      w.fixedField("last_s", static_cast<double>(in.last_ns) * 1e-9, 9).fixedField("first_tick", in.first_tick, 0);
+      w.fixedField("last_tick", in.last_tick, 0).field("tick_gaps", in.tick_gaps).field("tick_repeats", in.tick_repeats);
+      w.endObject();
     }
-    std::printf("{\"file\": \"%s\", \"format\": \"%s\", \"schema_version\": %d, \"scenario\": \"%s\", \"mode\": \"%s\", "
-                "\"controller\": \"%s\", \"created_utc\": \"%s\", \"robot_checksum\": \"%s\", \"dds_naming\": \"%s\", \"piece\": %d, "
-                "\"time_base_unix_ns\": %lld, \"first_unix_s\": %.6f, \"last_unix_s\": %.6f, \"file_bytes\": %llu, "
-                "\"objects\": %llu, \"unknown_objects\": %llu, \"labels\": {%s}, \"end\": \"%s\", "
-                "\"end_message\": \"%s\", \"csv_dir\": \"%s\"}\n",
-                jsonEscape(file).c_str(), jsonEscape(md.format).c_str(), md.schema_version, jsonEscape(md.scenario_name).c_str(),
-                jsonEscape(md.mode).c_str(), jsonEscape(md.controller).c_str(), jsonEscape(md.created_utc).c_str(),
-                jsonEscape(md.robot_checksum).c_str(), jsonEscape(md.dds_naming).c_str(), md.piece,
-                static_cast<long long>(md.time_base_unix_ns), first_unix_ns < 0 ? 0.0 : static_cast<double>(first_unix_ns) * 1e-9,
-                static_cast<double>(last_unix_ns) * 1e-9, static_cast<unsigned long long>(reader->fileSize()),
-                static_cast<unsigned long long>(reader->objects()), static_cast<unsigned long long>(unknown),
-                labels_json.c_str(), rawlog::toString(reader->end()), jsonEscape(reader->endMessage()).c_str(),
-                jsonEscape(csv_dir).c_str());
+    w.endObject().field("end", rawlog::toString(reader->end())).field("end_message", reader->endMessage());
+    w.field("csv_dir", csv_dir);
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("file       %s (%.2f MB, schema %d, piece %d)\n", file.c_str(), static_cast<double>(reader->fileSize()) / 1e6,
                 md.schema_version, md.piece);

@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
-#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -34,7 +33,6 @@ namespace mft::video {
 namespace {
 
 namespace fs = std::filesystem;
-using config::jsonEscape;
 
 constexpr int kExitBadInput = 2;
 constexpr int kExitCorrupt = 4;
@@ -42,27 +40,9 @@ constexpr int kExitInterrupted = 130;
 // mft-sim refuses a Disturbance beyond --max-push (default 200 N s); such a request is not drawn as a push.
 constexpr double kSimMaxPushNs = 200.0;
 
-void appendf(std::string* s, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
-void appendf(std::string* s, const char* fmt, ...) {
-  char buf[512];
-  va_list ap;
-  va_start(ap, fmt);
-  const int n = std::vsnprintf(buf, sizeof buf, fmt, ap);
-  va_end(ap);
-  if (n < 0) return;
-  if (static_cast<std::size_t>(n) < sizeof buf) {
-    s->append(buf, static_cast<std::size_t>(n));
-    return;
-  }
-  std::vector<char> big(static_cast<std::size_t>(n) + 1);
-  va_start(ap, fmt);
-  std::vsnprintf(big.data(), big.size(), fmt, ap);
-  va_end(ap);
-  s->append(big.data(), static_cast<std::size_t>(n));
-}
-
-void appendPoint(std::string* s, const char* key, const Eigen::Vector2d& p) {
-  appendf(s, "\"%s\": [%.9g, %.9g]", key, p.x(), p.y());
+constexpr int kPosition = 9;  // significant digits of positions in the renderer's JSON
+void writePoint(config::JsonWriter& w, const char* key, const Eigen::Vector2d& p) {
+  w.key(key).numbers({p.x(), p.y()}, kPosition);
 }
 
 std::string controllerTitle(const std::string& c) {
@@ -212,13 +192,11 @@ class Panel {
   // Everything the renderer needs once: names, the robot's size, the ground profile.
   std::string headerJson() const {
     const auto& md = metadata();
-    std::string s;
-    appendf(&s, "{\"file\": \"%s\", \"scenario\": \"%s\", \"controller\": \"%s\", \"title\": \"%s\", \"mode\": \"%s\", ",
-            jsonEscape(path_).c_str(), jsonEscape(md.scenario_name).c_str(), jsonEscape(md.controller).c_str(),
-            jsonEscape(controllerTitle(md.controller)).c_str(), jsonEscape(md.mode).c_str());
-    appendf(&s, "\"mft_space\": %s, \"duration_s\": %.6f, \"leg_reach_m\": %.6f, ", polytope_ ? "true" : "false",
-            expectedDuration(), robot_.thigh.length_m + robot_.shank.length_m);
-    appendf(&s, "\"terrain\": {\"name\": \"%s\", \"x\": [", jsonEscape(scenario_ ? scenario_->terrain : "flat").c_str());
+    config::JsonWriter w;
+    w.beginObject().field("file", path_).field("scenario", md.scenario_name).field("controller", md.controller);
+    w.field("title", controllerTitle(md.controller)).field("mode", md.mode).field("mft_space", polytope_.has_value());
+    w.fixedField("duration_s", expectedDuration(), 6).fixedField("leg_reach_m", robot_.thigh.length_m + robot_.shank.length_m, 6);
+    w.key("terrain").beginObject().field("name", scenario_ ? scenario_->terrain : std::string("flat"));
     // Breakpoints of the piecewise-linear profile, just either side of every segment end, so a step (a board
     // edge) is a vertical line and the flat ground before the first segment keeps its own height.
     std::vector<double> xs;
@@ -229,11 +207,11 @@ class Panel {
     }
     if (xs.empty()) xs.push_back(terrain_.start_x);
     std::sort(xs.begin(), xs.end());
-    for (std::size_t i = 0; i < xs.size(); ++i) appendf(&s, "%s%.9g", i ? ", " : "", xs[i]);
-    s += "], \"z\": [";
-    for (std::size_t i = 0; i < xs.size(); ++i) appendf(&s, "%s%.9g", i ? ", " : "", terrain_.heightAt(xs[i]));
-    s += "]}}";
-    return s;
+    w.key("x").beginArray();
+    for (const double x : xs) w.value(x, kPosition);
+    w.endArray().key("z").beginArray();
+    for (const double x : xs) w.value(terrain_.heightAt(x), kPosition);
+    return w.endArray().endObject().endObject().str();
   }
 
   // The current frame of this panel (the newest sample at or after the frame time, or the last one).
@@ -241,44 +219,38 @@ class Panel {
     model::VectorQ q;
     for (int i = 0; i < model::kNq; ++i) q[i] = gt_.q()[static_cast<std::size_t>(i)];
     const RobotDrawing d = drawer_->draw(q);
-    std::string s;
-    appendf(&s, "{\"t\": %.6f, \"tick\": %llu, \"ended\": %s, \"base\": [%.9g, %.9g, %.9g], \"ground_z\": %.9g, ",
-            gt_t_, static_cast<unsigned long long>(gt_.tick()), at_end_ && gt_t_ < t - 1e-9 ? "true" : "false", d.base.x(), d.base.y(),
-            d.base.z(), terrain_.heightAt(d.base.x()));
-    s += "\"torso\": [";
-    for (std::size_t i = 0; i < d.torso.size(); ++i) appendf(&s, "%s[%.9g, %.9g]", i ? ", " : "", d.torso[i].x(), d.torso[i].y());
-    s += "], ";
-    appendPoint(&s, "com", d.torso_com);
-    s += ", \"legs\": [";
+    config::JsonWriter w;
+    w.beginObject().fixedField("t", gt_t_, 6).field("tick", gt_.tick()).field("ended", at_end_ && gt_t_ < t - 1e-9);
+    w.key("base").numbers({d.base.x(), d.base.y(), d.base.z()}, kPosition);
+    w.field("ground_z", terrain_.heightAt(d.base.x()), kPosition).key("torso").beginArray();
+    for (const auto& p : d.torso) w.numbers({p.x(), p.y()}, kPosition);
+    w.endArray();
+    writePoint(w, "com", d.torso_com);
+    w.key("legs").beginArray();
     for (int leg = 0; leg < model::kNumLegs; ++leg) {
       const auto& l = d.legs[static_cast<std::size_t>(leg)];
-      s += leg ? ", {" : "{";
-      appendPoint(&s, "hip_rear", l.hip_rear);
-      s += ", ";
-      appendPoint(&s, "hip_fore", l.hip_fore);
-      s += ", ";
-      appendPoint(&s, "knee_rear", l.knee_rear);
-      s += ", ";
-      appendPoint(&s, "knee_fore", l.knee_fore);
-      s += ", ";
-      appendPoint(&s, "foot", l.foot);
-      s += ", ";
-      appendPoint(&s, "foot_fore", l.foot_fore);
+      w.beginObject();
+      writePoint(w, "hip_rear", l.hip_rear);
+      writePoint(w, "hip_fore", l.hip_fore);
+      writePoint(w, "knee_rear", l.knee_rear);
+      writePoint(w, "knee_fore", l.knee_fore);
+      writePoint(w, "foot", l.foot);
+      writePoint(w, "foot_fore", l.foot_fore);
       const double q_rear = q[model::hipRearIndex(leg)], q_fore = q[model::hipForeIndex(leg)];
-      const char* inside = !polytope_ ? "null" : polytope_->leg.contains(q_rear, q_fore) ? "true" : "false";
       const auto li = static_cast<std::size_t>(leg);
-      appendf(&s, ", \"closed\": %s, \"inside_mft\": %s, \"lti\": %.6g, \"force\": [%.6g, %.6g]}",
-              l.closed_by_kinematics ? "true" : "false", inside, gt_.lti()[li], gt_.contact_force()[2 * li],
-              gt_.contact_force()[2 * li + 1]);
+      w.field("closed", l.closed_by_kinematics).key("inside_mft");
+      if (polytope_) w.value(polytope_->leg.contains(q_rear, q_fore));
+      else w.null();
+      w.field("lti", gt_.lti()[li], 6).key("force");
+      w.numbers({gt_.contact_force()[2 * li], gt_.contact_force()[2 * li + 1]}, 6).endObject();
     }
-    s += "], \"push\": ";
+    w.endArray().key("push");
     const PushEvent* latest = nullptr;
     for (const auto& p : pushes_)
       if (p.applied && p.applied_s <= gt_t_ + 1e-9 && (!latest || p.applied_s >= latest->applied_s)) latest = &p;
-    if (latest) appendf(&s, "{\"impulse_Ns\": %.6g, \"t\": %.6f}", latest->impulse_Ns, latest->applied_s);
-    else s += "null";
-    s += "}";
-    return s;
+    if (latest) w.beginObject().field("impulse_Ns", latest->impulse_Ns, 6).fixedField("t", latest->applied_s, 6).endObject();
+    else w.null();
+    return w.endObject().str();
   }
 
  private:
@@ -392,13 +364,13 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
   // A recording of D s holds samples up to D - 1 ms: frames at from + i dt for from + i dt < D.
   const long frames_expected =
       end_for_estimate > from ? static_cast<long>(std::ceil((end_for_estimate - from) / frame_dt - 1e-6)) : 0;
-  std::string header;
-  appendf(&header, "{\"type\": \"header\", \"output\": \"%s\", \"final_output\": \"%s\", \"format\": \"%s\", \"ffmpeg\": \"%s\", ",
-          jsonEscape(tmp).c_str(), jsonEscape(out).c_str(), ext.substr(1).c_str(), jsonEscape(ffmpeg).c_str());
-  appendf(&header, "\"fps\": %ld, \"speed\": %.9g, \"from_s\": %.9g, \"frames_expected\": %ld, \"frame_log\": \"%s\", \"panels\": [",
-          fps, speed, from, frames_expected, jsonEscape(cli.get("frame-log")).c_str());
-  for (std::size_t i = 0; i < panels.size(); ++i) header += (i ? ", " : "") + panels[i]->headerJson();
-  header += "]}\n";
+  config::JsonWriter header_json;
+  header_json.beginObject().field("type", "header").field("output", tmp).field("final_output", out);
+  header_json.field("format", ext.substr(1)).field("ffmpeg", ffmpeg).field("fps", fps).field("speed", speed, kPosition);
+  header_json.field("from_s", from, kPosition).field("frames_expected", frames_expected);
+  header_json.field("frame_log", cli.get("frame-log")).key("panels").beginArray();
+  for (const auto& p : panels) header_json.raw(p->headerJson());
+  const std::string header = header_json.endArray().endObject().str() + "\n";
 
   // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/videos.md).
   std::signal(SIGPIPE, SIG_IGN);  // a renderer that died shows as a failed write, not as our death
@@ -430,9 +402,10 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
     }
     // Frames go on while any recording still has data at this time; one that ended shows its last state.
     if (!any_running) break;
-    std::string line = "{\"type\": \"frame\", \"i\": " + std::to_string(frames) + ", \"panels\": [";
-    for (std::size_t i = 0; i < panels.size(); ++i) line += (i ? ", " : "") + panels[i]->frameJson(t);
-    line += "]}\n";
+    config::JsonWriter frame;
+    frame.beginObject().field("type", "frame").field("i", frames).key("panels").beginArray();
+    for (const auto& p : panels) frame.raw(p->frameJson(t));
+    const std::string line = frame.endArray().endObject().str() + "\n";
     write_failed = std::fputs(line.c_str(), renderer) < 0;
     last_t = t;
     ++frames;
@@ -470,11 +443,12 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
   const double video_s = static_cast<double>(frames) / static_cast<double>(fps);
   const double bytes = static_cast<double>(fs::file_size(out));
   if (cli.isSet("json")) {
-    std::printf("{\"video\": \"%s\", \"format\": \"%s\", \"frames\": %ld, \"fps\": %ld, \"speed\": %.9g, \"from_s\": %.6f, "
-                "\"last_frame_s\": %.6f, \"video_s\": %.6f, \"panels\": %zu, \"bytes\": %.0f, \"wall_s\": %.3f, "
-                "\"frames_per_s\": %.2f}\n",
-                jsonEscape(out).c_str(), ext.substr(1).c_str(), frames, fps, speed, from, last_t, video_s, panels.size(),
-                bytes, wall, static_cast<double>(frames) / std::max(wall, 1e-9));
+    config::JsonWriter w;
+    w.beginObject().field("video", out).field("format", ext.substr(1)).field("frames", frames).field("fps", fps);
+    w.field("speed", speed, kPosition).fixedField("from_s", from, 6).fixedField("last_frame_s", last_t, 6);
+    w.fixedField("video_s", video_s, 6).field("panels", panels.size()).fixedField("bytes", bytes, 0);
+    w.fixedField("wall_s", wall, 3).fixedField("frames_per_s", static_cast<double>(frames) / std::max(wall, 1e-9), 2);
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("video      %s: %ld frames at %ld fps = %.2f s of video for %.3f-%.3f s of the run (x%g), %zu panel%s, "
                 "%.2f MB, rendered in %.1f s (%.1f frames/s)\n",

@@ -298,7 +298,6 @@ void withTopicType(const std::string& topic, F&& f) {
   else if (topic == "Disturbance") f(msg::Disturbance{}, msg::DisturbancePubSubType{});
 }
 
-using mft::config::jsonString;
 
 }  // namespace
 
@@ -470,37 +469,37 @@ static int toolMain(int argc, char** argv) {
   // Reliable event writers: a moment for the acknowledgement before the participant goes.
   if (publisher && isEventTopic(publish_topic)) std::this_thread::sleep_for(std::chrono::milliseconds(200));
 
-  std::string listen_json = "{";
+  config::JsonWriter listen_json;
+  listen_json.beginObject();
   std::string listen_text;
   for (const auto& [t, l] : listeners) {
     std::lock_guard<std::mutex> lock(l->stats.mutex);
+    auto& w = listen_json;
+    w.key(t).beginObject().field("matched_writers", l->matched()).field("received", l->stats.received.load());
+    w.field("nonfinite", l->stats.nonfinite.load()).field("first_tick", l->stats.first_tick);
+    w.field("last_tick", l->stats.last_tick).fixedField("max_gap_ms", static_cast<double>(l->stats.max_gap_ns) * 1e-6, 3);
+    w.field("max_gap_end_ns", l->stats.max_gap_end_ns).field("first_ns", l->stats.first_ns);
+    w.field("last_ns", l->stats.last_ns).endObject();
     char buf[400];
-    std::snprintf(buf, sizeof buf,
-                  "%s\"%s\": {\"matched_writers\": %d, \"received\": %llu, \"nonfinite\": %llu, \"first_tick\": %llu, "
-                  "\"last_tick\": %llu, \"max_gap_ms\": %.3f, \"max_gap_end_ns\": %lld, \"first_ns\": %lld, \"last_ns\": %lld}",
-                  listen_json.size() > 1 ? ", " : "", t.c_str(), l->matched(),
-                  static_cast<unsigned long long>(l->stats.received.load()),
-                  static_cast<unsigned long long>(l->stats.nonfinite.load()),
-                  static_cast<unsigned long long>(l->stats.first_tick), static_cast<unsigned long long>(l->stats.last_tick),
-                  static_cast<double>(l->stats.max_gap_ns) * 1e-6, static_cast<long long>(l->stats.max_gap_end_ns),
-                  static_cast<long long>(l->stats.first_ns), static_cast<long long>(l->stats.last_ns));
-    listen_json += buf;
     std::snprintf(buf, sizeof buf, "  %-16s matched writers %d, received %llu (non-finite %llu), largest gap %.1f ms\n",
                   t.c_str(), l->matched(), static_cast<unsigned long long>(l->stats.received.load()),
                   static_cast<unsigned long long>(l->stats.nonfinite.load()), static_cast<double>(l->stats.max_gap_ns) * 1e-6);
     listen_text += buf;
   }
-  listen_json += "}";
+  listen_json.endObject();
   const int matched_readers = publisher ? publisher->matched() : 0;
   const unsigned long long written = publisher ? static_cast<unsigned long long>(publisher->written()) : 0ULL;
   if (json) {
-    std::printf("{\"domain\": %d, \"identity\": %s, \"participant\": %s, \"publish\": %s, \"writer\": %s, "
-                "\"value\": %s, \"follow\": %s, \"matched_readers\": %d, \"matched_after_s\": %.3f, \"written\": %llu, "
-                "\"writers_matched_after_s\": %.3f, \"listen\": %s, \"error\": %s}\n",
-                domain, security.enabled() ? jsonString(security.identity).c_str() : "null",
-                jsonString(participant_status).c_str(), jsonString(publish_topic).c_str(), jsonString(writer_status).c_str(),
-                jsonString(cli.get("value")).c_str(), follow ? "true" : "false", matched_readers, matched_after_s, written,
-                writers_matched_after_s, listen_json.c_str(), jsonString(error).c_str());
+    config::JsonWriter w;
+    w.beginObject().field("domain", domain).key("identity");
+    if (security.enabled()) w.value(security.identity);
+    else w.null();
+    w.field("participant", participant_status).field("publish", publish_topic).field("writer", writer_status);
+    w.field("value", cli.get("value")).field("follow", follow).field("matched_readers", matched_readers);
+    w.fixedField("matched_after_s", matched_after_s, 3).field("written", written);
+    w.fixedField("writers_matched_after_s", writers_matched_after_s, 3).key("listen").raw(listen_json.str());
+    w.field("error", error);
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("mft-inject: domain %d, identity %s: participant %s\n", domain,
                 security.enabled() ? security.identity.c_str() : "(none)", participant_status.c_str());

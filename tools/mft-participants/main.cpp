@@ -37,23 +37,6 @@ struct Seen {
   bool left = false;  // it announced its end (or its lease expired) while we listened
 };
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (unsigned char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
-
 class DiscoveryListener : public fdds::DomainParticipantListener {
  public:
   explicit DiscoveryListener(Clock::time_point t0) : t0_(t0) {}
@@ -134,18 +117,16 @@ int toolMain(int argc, char** argv) {
   factory->delete_participant(participant);
 
   if (cli.isSet("json")) {
-    std::printf("{\"domain\": %d, \"wait_ms\": %.0f, \"listened_ms\": %.1f, \"participants\": [", domain, wait_ms,
-                listened_ms);
-    for (std::size_t i = 0; i < seen.size(); ++i) {
-      const Seen& s = seen[i];
-      std::printf("%s{\"name\": %s, \"guid_prefix\": %s, \"discovered_ms\": %.1f, \"left\": %s, \"addresses\": [",
-                  i ? ", " : "", jsonString(s.name).c_str(), jsonString(s.guid_prefix).c_str(), s.discovered_ms,
-                  s.left ? "true" : "false");
-      std::size_t k = 0;
-      for (const auto& a : s.addresses) std::printf("%s%s", k++ ? ", " : "", jsonString(a).c_str());
-      std::printf("]}");
+    mft::config::JsonWriter w;
+    w.beginObject().field("domain", domain).fixedField("wait_ms", wait_ms, 0).fixedField("listened_ms", listened_ms, 1);
+    w.key("participants").beginArray();
+    for (const Seen& p : seen) {
+      w.beginObject().field("name", p.name).field("guid_prefix", p.guid_prefix).fixedField("discovered_ms", p.discovered_ms, 1);
+      w.field("left", p.left).key("addresses").beginArray();
+      for (const auto& address : p.addresses) w.value(address);
+      w.endArray().endObject();
     }
-    std::printf("]}\n");
+    std::printf("%s\n", w.endArray().endObject().str().c_str());
   } else {
     std::printf("domain %d: %zu participant(s) in %.0f ms\n", domain, seen.size(), listened_ms);
     for (const Seen& s : seen) {

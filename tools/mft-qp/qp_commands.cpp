@@ -135,23 +135,12 @@ double percentile(const std::vector<double>& sorted, double p) {
   return sorted[i];
 }
 
-std::string num(double v) {
-  if (std::isnan(v)) return "null";
-  if (std::isinf(v)) return v > 0 ? "1e308" : "-1e308";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-// Full precision for solution values (round-trips like the instance files).
-std::string numExact(double v) {
-  if (!std::isfinite(v)) return num(v);
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
-using config::jsonString;
+// Residuals and timings at 6 significant digits; an infinite residual as +-1e308 (a number, so that a
+// comparison in a script still works), NaN as null.
+constexpr int kDigits = 6;
+double clampInfinite(double v) { return std::isinf(v) ? (v > 0 ? 1e308 : -1e308) : v; }
+// Solution values at full precision (they round-trip like the instance files).
+constexpr int kExact = 17;
 
 }  // namespace
 
@@ -216,15 +205,15 @@ int runBench(const BenchOptions& o) {
   const double iter_mean = static_cast<double>(iterations_sum) / static_cast<double>(count);
 
   if (o.json) {
-    std::cout << "{\"dir\": " << jsonString(o.dir) << ", \"count\": " << count << ", \"passes\": " << o.passes
-              << ", \"warm\": " << (o.warm ? "true" : "false") << ", \"failures\": " << failures
-              << ", \"warm_fallbacks\": " << fallbacks << ", \"max_x_err\": " << num(worst.x_err)
-              << ", \"max_kkt\": " << num(worst.kkt) << ", \"active_mismatch_steps\": " << steps_mismatched
-              << ", \"active_mismatch_steps_nondegenerate\": " << steps_strict
-              << ", \"iterations_mean\": " << num(iter_mean) << ", \"iterations_max\": " << iterations_max
-              << ", \"mean_us\": " << num(mean) << ", \"p50_us\": " << num(percentile(sorted, 0.5))
-              << ", \"p99_us\": " << num(percentile(sorted, 0.99)) << ", \"max_us\": " << num(sorted.back())
-              << ", \"raw_max_us\": " << num(raw_max) << ", \"process\": " << jsonString(notes) << "}\n";
+    config::JsonWriter w;
+    w.beginObject().field("dir", o.dir).field("count", count).field("passes", o.passes).field("warm", o.warm);
+    w.field("failures", failures).field("warm_fallbacks", fallbacks).field("max_x_err", clampInfinite(worst.x_err), kDigits);
+    w.field("max_kkt", clampInfinite(worst.kkt), kDigits).field("active_mismatch_steps", steps_mismatched);
+    w.field("active_mismatch_steps_nondegenerate", steps_strict).field("iterations_mean", iter_mean, kDigits);
+    w.field("iterations_max", iterations_max).field("mean_us", mean, kDigits);
+    w.field("p50_us", percentile(sorted, 0.5), kDigits).field("p99_us", percentile(sorted, 0.99), kDigits);
+    w.field("max_us", sorted.back(), kDigits).field("raw_max_us", raw_max, kDigits).field("process", notes);
+    std::cout << w.endObject().str() << "\n";
   } else {
     std::printf("instances            %zu (%s)\n", count, o.dir.c_str());
     std::printf("mode                 %s, %d passes, per-step minimum over passes (%s)\n", o.warm ? "warm" : "cold",
@@ -261,18 +250,24 @@ int runSolve(const SolveOptions& o) {
   for (int i = 0; i < p.n + p.nin; ++i)
     if (sol.active[i]) active << (active.tellp() ? " " : "") << (i < p.n ? "x" : "row") << (i < p.n ? i : i - p.n) << (sol.active[i] > 0 ? "+" : "-");
   if (o.json) {
-    std::cout << "{\"file\": " << jsonString(o.file) << ", \"name\": " << jsonString(inst.name)
-              << ", \"status\": " << jsonString(status) << ", \"unverified_because\": " << (why.empty() ? "null" : jsonString(why))
-              << ", \"iterations\": " << sol.iterations
-              << ", \"objective\": " << numExact(sol.objective)
-              << ", \"f_ref\": " << (inst.f_ref ? numExact(*inst.f_ref) : "null")
-              << ", \"max_x_err\": " << (inst.x_ref ? num(a.x_err) : "null")
-              << ", \"kkt\": {\"stationarity\": " << num(kkt.stationarity) << ", \"primal\": " << num(kkt.primal)
-              << ", \"dual\": " << num(kkt.dual) << ", \"complementarity\": " << num(kkt.complementarity) << "}"
-              << ", \"active_mismatch\": " << (inst.active_ref ? std::to_string(a.mismatched) : "null")
-              << ", \"active\": " << jsonString(active.str()) << ", \"solve_us\": " << num(us) << ", \"x\": [";
-    for (int j = 0; j < p.n; ++j) std::cout << (j ? ", " : "") << numExact(sol.x[j]);
-    std::cout << "]}\n";
+    config::JsonWriter w;
+    w.beginObject().field("file", o.file).field("name", inst.name).field("status", status).key("unverified_because");
+    if (why.empty()) w.null();
+    else w.value(why);
+    w.field("iterations", sol.iterations).field("objective", clampInfinite(sol.objective), kExact).key("f_ref");
+    if (inst.f_ref) w.value(clampInfinite(*inst.f_ref), kExact);
+    else w.null();
+    w.key("max_x_err");
+    if (inst.x_ref) w.value(clampInfinite(a.x_err), kDigits);
+    else w.null();
+    w.key("kkt").beginObject().field("stationarity", clampInfinite(kkt.stationarity), kDigits);
+    w.field("primal", clampInfinite(kkt.primal), kDigits).field("dual", clampInfinite(kkt.dual), kDigits);
+    w.field("complementarity", clampInfinite(kkt.complementarity), kDigits).endObject().key("active_mismatch");
+    if (inst.active_ref) w.value(a.mismatched);
+    else w.null();
+    w.field("active", active.str()).field("solve_us", us, kDigits).key("x").beginArray();
+    for (int j = 0; j < p.n; ++j) w.value(clampInfinite(sol.x[j]), kExact);
+    std::cout << w.endArray().endObject().str() << "\n";
   } else {
     std::printf("instance        %s (%s)\n", inst.name.c_str(), o.file.c_str());
     std::printf("status          %s, %d iterations, %.2f us (single cold call)\n", status.c_str(), sol.iterations, us);

@@ -46,7 +46,6 @@ std::string takeFile(int* argc, char** argv) {
   return f;
 }
 
-using config::jsonEscape;
 
 // ------------------------------------------------------------------------------------------ --through-wbc
 // The WBC changes applied while the run was recorded (live tuning, docs/live-tuning.md): a first pass over the
@@ -231,15 +230,14 @@ int throughWbc(rawlog::RawlogReader& reader, const services::CommandLine& cli) {
   drain(newest, true);
   const bool ok = compared > 0 && differing == 0;
   if (json) {
-    std::printf("{\"mode\": \"through-wbc\", \"file\": \"%s\", \"ticks_compared\": %llu, \"unmatched_commands\": %llu, "
-                "\"max_abs_diff_Nm\": %.17g, \"max_diff_tick\": %lld, \"tolerance\": %.17g, \"differing_ticks\": %llu, "
-                "\"first_differing_tick\": %lld, \"first_difference_Nm\": %.17g, \"mode_mismatches\": %llu, "
-                "\"live_changes\": %zu, \"live_changes_applied\": %zu, \"end\": \"%s\", \"end_message\": \"%s\", \"ok\": %s}\n",
-                jsonEscape(reader.path()).c_str(), static_cast<unsigned long long>(compared),
-                static_cast<unsigned long long>(unmatched), max_diff, max_diff_tick, tolerance,
-                static_cast<unsigned long long>(differing), first_diff_tick, first_diff_value,
-                static_cast<unsigned long long>(mode_mismatches), changes.size(), next_change, rawlog::toString(reader.end()),
-                jsonEscape(reader.endMessage()).c_str(), ok ? "true" : "false");
+    config::JsonWriter w;
+    w.beginObject().field("mode", "through-wbc").field("file", reader.path()).field("ticks_compared", compared);
+    w.field("unmatched_commands", unmatched).field("max_abs_diff_Nm", max_diff, 17).field("max_diff_tick", max_diff_tick);
+    w.field("tolerance", tolerance, 17).field("differing_ticks", differing).field("first_differing_tick", first_diff_tick);
+    w.field("first_difference_Nm", first_diff_value, 17).field("mode_mismatches", mode_mismatches);
+    w.field("live_changes", changes.size()).field("live_changes_applied", next_change);
+    w.field("end", rawlog::toString(reader.end())).field("end_message", reader.endMessage()).field("ok", ok);
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("through-wbc  %s (%s, controller %s)\n", reader.path().c_str(), md.mode.c_str(), md.controller.c_str());
     std::printf("compared     %llu ticks (%llu commands without their state/reference)\n",
@@ -502,25 +500,27 @@ static int toolMain(int argc, char** argv) {
                                       : reader->endMessage();
   const double wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
   std::uint64_t total = 0;
-  std::string per_topic;
+  config::JsonWriter published_json;
+  published_json.beginObject();
   for (std::size_t i = 0; i < rawlog::kNumTopics; ++i) {
     total += published[i];
     if (!topics.count(static_cast<rawlog::Topic>(i))) continue;
-    per_topic += (per_topic.empty() ? "\"" : ", \"") + std::string(rawlog::topicName(static_cast<rawlog::Topic>(i))) +
-                 "\": " + std::to_string(published[i]);
+    const std::string name = rawlog::topicName(static_cast<rawlog::Topic>(i));
+    published_json.field(name, published[i]);
   }
+  published_json.endObject();
   if (json) {
-    std::printf("{\"mode\": \"publish\", \"file\": \"%s\", \"domain\": %ld, \"rate\": %g, \"loops\": %llu, "
-                "\"messages\": %llu, \"published\": {%s}, \"played_recorded_s\": %.6f, \"wall_s\": %.6f, "
-                "\"lateness_us\": %s, \"interrupted\": %s, \"end\": \"%s\", \"end_message\": \"%s\"}\n",
-                jsonEscape(file).c_str(), cli.getInt("domain", 0, 232), rate, static_cast<unsigned long long>(loops),
-                static_cast<unsigned long long>(total), per_topic.c_str(), played_span_s, wall_s,
-                lateness_us.json().c_str(), interrupted ? "true" : "false", rawlog::toString(reader->end()),
-                jsonEscape(end_message).c_str());
+    config::JsonWriter w;
+    w.beginObject().field("mode", "publish").field("file", file).field("domain", cli.getInt("domain", 0, 232));
+    w.field("rate", rate, 6).field("loops", loops).field("messages", total).key("published").raw(published_json.str());
+    w.fixedField("played_recorded_s", played_span_s, 6).fixedField("wall_s", wall_s, 6);
+    w.key("lateness_us").raw(lateness_us.json()).field("interrupted", interrupted);
+    w.field("end", rawlog::toString(reader->end())).field("end_message", end_message);
+    std::printf("%s\n", w.endObject().str().c_str());
   } else {
     std::printf("replayed   %s on domain %ld at rate %g (%llu loop(s))\n", file.c_str(), cli.getInt("domain", 0, 232),
                 rate, static_cast<unsigned long long>(loops));
-    std::printf("messages   %llu: {%s}\n", static_cast<unsigned long long>(total), per_topic.c_str());
+    std::printf("messages   %llu: %s\n", static_cast<unsigned long long>(total), published_json.str().c_str());
     std::printf("time       %.3f s recorded in %.3f s wall\n", played_span_s, wall_s);
     std::printf("lateness   %s us\n", lateness_us.json().c_str());
     std::printf("file       %s\n", end_message.c_str());

@@ -17,14 +17,14 @@ std::string gridJson(const LabelGrid& g) {
   std::string labels;
   labels.reserve(g.labels.size());
   for (auto l : g.labels) labels += static_cast<char>('0' + l);
-  auto axis = [](const GridAxis& a) { return JsonObject().num("lo", a.lo).num("step", a.step).num("n", a.n).str(); };
-  return JsonObject().raw("x", axis(g.x)).raw("y", axis(g.y)).str("labels", labels).str();
+  auto axis = [](const GridAxis& a) { return JsonWriter().beginObject().field("lo", a.lo, kDigits).field("step", a.step, kDigits).field("n", a.n, kDigits).str(); };
+  return JsonWriter().beginObject().key("x").raw(axis(g.x)).key("y").raw(axis(g.y)).field("labels", labels).endObject().str();
 }
 std::string pointsJson(const std::vector<Eigen::Vector2d>& pts) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    s += (i ? ", [" : "[") + jsonNumber(pts[i].x()) + ", " + jsonNumber(pts[i].y()) + "]";
-  return s + "]";
+  JsonWriter w;
+  w.beginArray();
+  for (const auto& p : pts) w.numbers({p.x(), p.y()}, kDigits);
+  return w.endArray().str();
 }
 // Shell-quotes one argument for std::system.
 std::string quote(const std::string& s) {
@@ -49,22 +49,22 @@ void writeFigureData(const std::string& path, const FigureInput& in) {
   }
   const auto& c = *in.criteria;
   const std::string json =
-      JsonObject()
-          .str("robot", in.robot->name)
-          .raw("joint", gridJson(*in.joint))
-          .raw("cartesian", gridJson(*in.cartesian))
-          .raw("polygon", pointsJson(v))
-          .raw("polygon_cartesian", pointsJson(image))
-          .raw("lti", "[" + jsonNumber(c.lti.lo) + ", " + jsonNumber(c.lti.hi) + "]")
-          .raw("raci", "[" + jsonNumber(c.raci.lo) + ", " + jsonNumber(c.raci.hi) + "]")
-          .str("raci_form", raciFormName(c.raci_options.form))
-          .num("accel_max", c.raci_options.accel_max_mps2)
-          .raw("rear_hip", "[" + jsonNumber(in.robot->rear_hip_rad.lo) + ", " + jsonNumber(in.robot->rear_hip_rad.hi) + "]")
-          .raw("fore_hip", "[" + jsonNumber(in.robot->fore_hip_rad.lo) + ", " + jsonNumber(in.robot->fore_hip_rad.hi) + "]")
-          .num("coverage", in.coverage)
-          .num("r_max", in.r_max)
-          .num("area", in.area)
-          .str();
+      JsonWriter().beginObject()
+          .field("robot", in.robot->name)
+          .key("joint").raw(gridJson(*in.joint))
+          .key("cartesian").raw(gridJson(*in.cartesian))
+          .key("polygon").raw(pointsJson(v))
+          .key("polygon_cartesian").raw(pointsJson(image))
+          .key("lti").raw(JsonWriter().numbers({c.lti.lo, c.lti.hi}, kDigits).str())
+          .key("raci").raw(JsonWriter().numbers({c.raci.lo, c.raci.hi}, kDigits).str())
+          .field("raci_form", raciFormName(c.raci_options.form))
+          .field("accel_max", c.raci_options.accel_max_mps2, kDigits)
+          .key("rear_hip").raw(JsonWriter().numbers({in.robot->rear_hip_rad.lo, in.robot->rear_hip_rad.hi}, kDigits).str())
+          .key("fore_hip").raw(JsonWriter().numbers({in.robot->fore_hip_rad.lo, in.robot->fore_hip_rad.hi}, kDigits).str())
+          .field("coverage", in.coverage, kDigits)
+          .field("r_max", in.r_max, kDigits)
+          .field("area", in.area, kDigits)
+          .endObject().str();
   std::ofstream out(path);
   out << json << "\n";
   out.close();

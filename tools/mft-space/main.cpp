@@ -131,7 +131,7 @@ int cmdFit(int argc, char** argv) {
   writePolytopeFile(output, r, robot);
   progress.stage("wrote " + output);
   if (a.flag("json")) {
-    std::cout << JsonObject().str("output", output).raw("fit", summaryJson(r)).str() << "\n";
+    std::cout << JsonWriter().beginObject().field("output", output).key("fit").raw(summaryJson(r)).endObject().str() << "\n";
   } else {
     std::cout << summaryText(r) << "written         " << output << "\n";
     if (!r.has_augmented) std::cout << "note            not a hexagon: the WBC loader accepts only 6 edges\n";
@@ -152,7 +152,7 @@ int cmdFigure(int argc, char** argv) {
   progress.stage("drawing " + png);
   const std::string why = drawFigure(data, png, figureScript());
   if (a.flag("json"))
-    std::cout << JsonObject().str("png", png).str("data", data).boolean("drawn", why.empty()).str("error", why).str()
+    std::cout << JsonWriter().beginObject().field("png", png).field("data", data).field("drawn", why.empty()).field("error", why).endObject().str()
               << "\n";
   else
     std::cout << (why.empty() ? "figure written to " + png : "figure NOT drawn: " + why) << "\n";
@@ -219,15 +219,15 @@ int cmdAll(int argc, char** argv) {
   writeText(dir + "/summary.json", summaryJson(r) + "\n");
   progress.stage("wrote " + dir + "/stance.txt, stance.json, summary.json");
   if (a.flag("json")) {
-    std::cout << JsonObject()
-                     .str("out", dir)
-                     .str("yaml", yaml)
-                     .str("png", why.empty() ? png : "")
-                     .str("figure_error", why)
-                     .raw("fit", summaryJson(r))
-                     .raw("stance", stanceJson(rows))
-                     .num("seconds", progress.seconds())
-                     .str()
+    std::cout << JsonWriter().beginObject()
+                     .field("out", dir)
+                     .field("yaml", yaml)
+                     .field("png", why.empty() ? png : "")
+                     .field("figure_error", why)
+                     .key("fit").raw(summaryJson(r))
+                     .key("stance").raw(stanceJson(rows))
+                     .field("seconds", progress.seconds(), kDigits)
+                     .endObject().str()
               << "\n";
   } else {
     std::cout << summaryText(r) << "\n" << table << "\nwritten to " << dir << ": mft_space.yaml, "

@@ -131,38 +131,37 @@ void writePolytopeFile(const std::string& path, const SpaceResult& r, const Robo
 
 std::string summaryJson(const SpaceResult& r) {
   const auto& q = r.quality;
-  std::string edges = "[";
+  JsonWriter edges;
+  edges.beginArray();
   for (int k = 0; k < r.fit.polygon.size(); ++k) {
     const Eigen::Vector2d n = r.fit.polygon.normal(k);
-    edges += (k ? ", " : "") + JsonObject().raw("normal", "[" + jsonNumber(n.x()) + ", " + jsonNumber(n.y()) + "]")
-                                   .num("offset", r.fit.polygon.offset[k]).str();
+    edges.beginObject().key("normal").numbers({n.x(), n.y()}, kDigits);
+    edges.field("offset", r.fit.polygon.offset[k], kDigits).endObject();
   }
-  edges += "]";
-  std::string verts = "[";
-  for (std::size_t i = 0; i < r.polytope.leg.vertices.size(); ++i) {
-    const auto& v = r.polytope.leg.vertices[i];
-    verts += (i ? ", [" : "[") + jsonNumber(v.x()) + ", " + jsonNumber(v.y()) + "]";
-  }
-  verts += "]";
-  return JsonObject()
-      .num("joint_step_rad", r.polytope.fit.joint_step_rad)
-      .num("joint_nodes", static_cast<double>(r.joint.labels.size()))
-      .num("reachable_cells", r.polytope.fit.reachable_cells)
-      .num("preferable_cells", r.polytope.fit.preferable_cells)
-      .num("cartesian_step_m", r.polytope.fit.cartesian_step_m)
-      .num("cartesian_reachable_cells", r.cartesian.countAtLeast(kCellReachable))
-      .num("cartesian_preferable_cells", r.cartesian.count(kCellPreferable))
-      .num("edges", r.fit.polygon.size())
-      .num("area_rad2", r.fit.area)
-      .num("coverage", q.coverage)
-      .num("covered_cells", q.good_inside)
-      .num("bad_cells_inside", q.bad_inside)
-      .num("r_max_rad", q.r_max)
-      .num("grid_seconds", r.grid_seconds)
-      .num("fit_seconds", r.fit_seconds)
-      .raw("polygon_edges", edges)
-      .raw("polygon_vertices", verts)
-      .str();
+  edges.endArray();
+  JsonWriter verts;
+  verts.beginArray();
+  for (const auto& v : r.polytope.leg.vertices) verts.numbers({v.x(), v.y()}, kDigits);
+  verts.endArray();
+  return JsonWriter().beginObject()
+      .field("joint_step_rad", r.polytope.fit.joint_step_rad, kDigits)
+      .field("joint_nodes", static_cast<double>(r.joint.labels.size()), kDigits)
+      .field("reachable_cells", r.polytope.fit.reachable_cells, kDigits)
+      .field("preferable_cells", r.polytope.fit.preferable_cells, kDigits)
+      .field("cartesian_step_m", r.polytope.fit.cartesian_step_m, kDigits)
+      .field("cartesian_reachable_cells", r.cartesian.countAtLeast(kCellReachable), kDigits)
+      .field("cartesian_preferable_cells", r.cartesian.count(kCellPreferable), kDigits)
+      .field("edges", r.fit.polygon.size(), kDigits)
+      .field("area_rad2", r.fit.area, kDigits)
+      .field("coverage", q.coverage, kDigits)
+      .field("covered_cells", q.good_inside, kDigits)
+      .field("bad_cells_inside", q.bad_inside, kDigits)
+      .field("r_max_rad", q.r_max, kDigits)
+      .field("grid_seconds", r.grid_seconds, kDigits)
+      .field("fit_seconds", r.fit_seconds, kDigits)
+      .key("polygon_edges").raw(edges.str())
+      .key("polygon_vertices").raw(verts.str())
+      .endObject().str();
 }
 
 std::string summaryText(const SpaceResult& r) {

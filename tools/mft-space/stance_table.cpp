@@ -55,27 +55,27 @@ std::string stanceText(const std::vector<StanceRow>& rows, const MftCriteria& c)
 }
 
 std::string stanceJson(const std::vector<StanceRow>& rows) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const auto& r = rows[i];
+  JsonWriter w;
+  w.beginArray();
+  for (const auto& r : rows) {
     const auto& e = r.eval;
-    s += (i ? ", " : "") + JsonObject()
-                               .num("base_height_m", r.base_height)
-                               .num("d_m", r.d)
-                               .str("status", fiveBarStatusName(e.status))
-                               .num("q_rear", e.pose.q_rear)
-                               .num("q_fore", e.pose.q_fore)
-                               .num("iti", e.indices.iti())
-                               .num("oti", e.indices.oti)
-                               .num("lti", e.indices.lti())
-                               .num("raci", e.raci.raci)
-                               .num("raci_optimal", r.raci_optimal)
-                               .num("raci_fixed", r.raci_fixed)
-                               .boolean("preferable", e.preferable)
-                               .boolean("inside_polygon", r.inside)
-                               .str();
+    w.beginObject()
+                               .field("base_height_m", r.base_height, kDigits)
+                               .field("d_m", r.d, kDigits)
+                               .field("status", fiveBarStatusName(e.status))
+                               .field("q_rear", e.pose.q_rear, kDigits)
+                               .field("q_fore", e.pose.q_fore, kDigits)
+                               .field("iti", e.indices.iti(), kDigits)
+                               .field("oti", e.indices.oti, kDigits)
+                               .field("lti", e.indices.lti(), kDigits)
+                               .field("raci", e.raci.raci, kDigits)
+                               .field("raci_optimal", r.raci_optimal, kDigits)
+                               .field("raci_fixed", r.raci_fixed, kDigits)
+                               .field("preferable", e.preferable)
+                               .field("inside_polygon", r.inside)
+                               .endObject();
   }
-  return s + "]";
+  return w.endArray().str();
 }
 
 std::string indexText(const LegEvaluation& e, const MftCriteria& c) {
@@ -104,28 +104,28 @@ std::string indexText(const LegEvaluation& e, const MftCriteria& c) {
 }
 
 std::string indexJson(const LegEvaluation& e, const MftCriteria& c) {
-  return JsonObject()
-      .num("q_rear", e.pose.q_rear)
-      .num("q_fore", e.pose.q_fore)
-      .str("status", fiveBarStatusName(e.status))
-      .boolean("within_limits", e.within_limits)
-      .num("foot_x", e.status == FiveBarStatus::Ok ? e.pose.foot.x() : NAN)
-      .num("foot_z", e.status == FiveBarStatus::Ok ? e.pose.foot.y() : NAN)
-      .num("knee_rear", e.status == FiveBarStatus::Ok ? e.pose.knee_rear : NAN)
-      .num("knee_fore", e.status == FiveBarStatus::Ok ? e.pose.knee_fore : NAN)
-      .num("iti_rear", e.indices.iti_rear)
-      .num("iti_fore", e.indices.iti_fore)
-      .num("gamma_I", e.indices.iti())
-      .num("gamma_O", e.indices.oti)
-      .num("lti", e.indices.lti())
-      .str("raci_form", raciFormName(c.raci_options.form))
-      .boolean("raci_gravity", c.raci_options.gravity)
-      .num("raci", e.raci.raci)
-      .num("raci_rear", e.raci.tau_rear)
-      .num("raci_fore", e.raci.tau_fore)
-      .boolean("singular", e.raci.singular || e.indices.lti() == 0.0)
-      .boolean("preferable", e.preferable)
-      .str();
+  return JsonWriter().beginObject()
+      .field("q_rear", e.pose.q_rear, kDigits)
+      .field("q_fore", e.pose.q_fore, kDigits)
+      .field("status", fiveBarStatusName(e.status))
+      .field("within_limits", e.within_limits)
+      .field("foot_x", e.status == FiveBarStatus::Ok ? e.pose.foot.x() : NAN, kDigits)
+      .field("foot_z", e.status == FiveBarStatus::Ok ? e.pose.foot.y() : NAN, kDigits)
+      .field("knee_rear", e.status == FiveBarStatus::Ok ? e.pose.knee_rear : NAN, kDigits)
+      .field("knee_fore", e.status == FiveBarStatus::Ok ? e.pose.knee_fore : NAN, kDigits)
+      .field("iti_rear", e.indices.iti_rear, kDigits)
+      .field("iti_fore", e.indices.iti_fore, kDigits)
+      .field("gamma_I", e.indices.iti(), kDigits)
+      .field("gamma_O", e.indices.oti, kDigits)
+      .field("lti", e.indices.lti(), kDigits)
+      .field("raci_form", raciFormName(c.raci_options.form))
+      .field("raci_gravity", c.raci_options.gravity)
+      .field("raci", e.raci.raci, kDigits)
+      .field("raci_rear", e.raci.tau_rear, kDigits)
+      .field("raci_fore", e.raci.tau_fore, kDigits)
+      .field("singular", e.raci.singular || e.indices.lti() == 0.0)
+      .field("preferable", e.preferable)
+      .endObject().str();
 }
 
 }  // namespace mft::tools

@@ -12,23 +12,20 @@ namespace mft::services {
 
 using config::StrictNode;
 
-const char* toString(LocomotionMode m) {
-  switch (m) {
-    case LocomotionMode::Stand: return "stand";
-    case LocomotionMode::StepInPlace: return "step_in_place";
-    case LocomotionMode::Walk: return "walk";
-  }
-  return "?";
-}
+constexpr config::EnumName<LocomotionMode> kModeNames[] = {{LocomotionMode::Stand, "stand"},
+                                                           {LocomotionMode::StepInPlace, "step_in_place"},
+                                                           {LocomotionMode::Walk, "walk"}};
+
+const char* toString(LocomotionMode m) { return config::nameOf(kModeNames, m); }
 
 namespace {
 
 LocomotionMode parseMode(StrictNode& n, const std::string& key) {
   const std::string s = n.text(key);
-  if (s == "stand") return LocomotionMode::Stand;
-  if (s == "step_in_place") return LocomotionMode::StepInPlace;
-  if (s == "walk") return LocomotionMode::Walk;
-  n.fail(key, "unknown mode '" + s + "' (expected stand, step_in_place or walk)");
+  LocomotionMode mode{};
+  if (!config::parseName(kModeNames, s, &mode))
+    n.fail(key, "unknown mode '" + s + "' (expected " + config::nameList(kModeNames) + ")");
+  return mode;
 }
 
 std::string oneOf(StrictNode& n, const std::string& key, std::initializer_list<const char*> allowed) {

@@ -6,6 +6,18 @@
 
 using namespace mft;
 
+namespace {
+// `value` converted to the DDS message `Msg` and back.
+template <class Msg, class T>
+T roundTrip(const T& value) {
+  Msg m;
+  services::toMsg(value, &m);
+  T back;
+  services::fromMsg(m, &back);
+  return back;
+}
+}  // namespace
+
 TEST(Convert, SensorReadingsRoundTrip) {
   model::SensorReadings s;
   s.tick = 77;
@@ -20,10 +32,7 @@ TEST(Convert, SensorReadingsRoundTrip) {
   s.gyro_pitch_rate = 0.3;
   s.accel = {0.5, 9.7};
   s.contact = {true, false};
-  msg::SensorData m;
-  services::toMsg(s, &m);
-  model::SensorReadings back;
-  services::fromMsg(m, &back);
+  const model::SensorReadings back = roundTrip<msg::SensorData>(s);
   EXPECT_EQ(back.tick, 77u);
   EXPECT_NEAR(back.time_s, 0.077, 1e-12);
   EXPECT_EQ(back.actuated_pos, s.actuated_pos);
@@ -42,10 +51,7 @@ TEST(Convert, StateTruthAndCommandRoundTrip) {
   st.q = model::VectorQ::LinSpaced(-1, 1);
   st.qd = model::VectorQ::LinSpaced(2, 3);
   st.contact = {false, true};
-  msg::RobotState ms;
-  services::toMsg(st, &ms);
-  model::RobotStateEstimate st2;
-  services::fromMsg(ms, &st2);
+  const model::RobotStateEstimate st2 = roundTrip<msg::RobotState>(st);
   EXPECT_EQ(st2.q, st.q);
   EXPECT_EQ(st2.qd, st.qd);
   EXPECT_EQ(st2.contact, st.contact);
@@ -54,10 +60,7 @@ TEST(Convert, StateTruthAndCommandRoundTrip) {
   gt.q = model::VectorQ::Constant(0.25);
   gt.contact_force << 1, 2, 3, 4;
   gt.lti = {0.8, 0.6};
-  msg::GroundTruth mg;
-  services::toMsg(gt, &mg);
-  model::GroundTruthState gt2;
-  services::fromMsg(mg, &gt2);
+  const model::GroundTruthState gt2 = roundTrip<msg::GroundTruth>(gt);
   EXPECT_EQ(gt2.q, gt.q);
   EXPECT_EQ(gt2.contact_force, gt.contact_force);
   EXPECT_EQ(gt2.lti, gt.lti);

@@ -18,7 +18,20 @@ from .paths import DEFAULT_BIN as BIN
 from .paths import DEFAULT_CONFIG as CONFIG
 from .paths import REPO, SCENARIOS, SUPERVISOR
 
-__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "pid_alive"]
+__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "StackUpTestCase", "mft_cmd",
+           "pid_alive", "processes_mentioning"]
+
+
+def mft_cmd(domain, *args, timeout=60):
+    """Runs mft-cmd --json on `domain`; returns (exit code, parsed JSON or None, stderr, wall seconds)."""
+    t0 = time.monotonic()
+    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
+                       capture_output=True, text=True, timeout=timeout)
+    try:
+        result = json.loads(p.stdout)
+    except ValueError:
+        result = None
+    return p.returncode, result, p.stderr, time.monotonic() - t0
 
 
 def processes_mentioning(text):

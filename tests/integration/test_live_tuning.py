@@ -19,6 +19,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack import testing  # noqa: E402
 from mftstack.testing import BIN, SCENARIOS, StackRunner, StackUpTestCase  # noqa: E402
 
 DOMAIN_LOCKSTEP, DOMAIN_REALTIME = 98, 99
@@ -27,15 +28,10 @@ DURATION_S = 24.0  # of the standing run
 KP_BEFORE, KP_AFTER = 400.0, 100.0
 
 
+
 def mft_cmd(domain, *args, timeout=120):
     """mft-cmd --json; returns (exit code, parsed JSON or None, stderr)."""
-    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
-                       capture_output=True, text=True, timeout=timeout)
-    try:
-        result = json.loads(p.stdout)
-    except ValueError:
-        result = None
-    return p.returncode, result, p.stderr
+    return testing.mft_cmd(domain, *args, timeout=timeout)[:3]
 
 
 def export(rawlog, out, labels):

@@ -16,21 +16,10 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, SCENARIOS, StackUpTestCase  # noqa: E402
+from mftstack.testing import BIN, SCENARIOS, StackUpTestCase, mft_cmd  # noqa: E402
 
 DOMAIN_STACK, DOMAIN_EMPTY, DOMAIN_LATE = 90, 91, 92
 
-
-def mft_cmd(domain, *args, timeout=60):
-    """Runs mft-cmd --json; returns (exit code, parsed JSON or None, stderr, wall seconds)."""
-    t0 = time.monotonic()
-    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
-                       capture_output=True, text=True, timeout=timeout)
-    try:
-        result = json.loads(p.stdout)
-    except ValueError:
-        result = None
-    return p.returncode, result, p.stderr, time.monotonic() - t0
 
 
 class OperatorCommandsOnARunningStack(StackUpTestCase):

@@ -119,3 +119,54 @@ TEST(Convert, PlanToWbcReference) {
   services::fromMsg(m, &r);
   EXPECT_FALSE(r.hold_base_x);
 }
+
+TEST(Convert, OperatorCommandModeOctets) {
+  msg::OperatorCommand m;
+  m.z_cmd(0.41);
+  m.v_cmd(0.25);
+  planner::OperatorCommand c;
+  const std::pair<std::uint8_t, planner::LocomotionMode> octets[] = {
+      {msg::LOCOMOTION_STAND, planner::LocomotionMode::Stand},
+      {msg::LOCOMOTION_STEP_IN_PLACE, planner::LocomotionMode::StepInPlace},
+      {msg::LOCOMOTION_WALK, planner::LocomotionMode::Walk},
+      {static_cast<std::uint8_t>(msg::LOCOMOTION_WALK + 1), planner::LocomotionMode::Stand}};  // refused upstream
+  for (const auto& [octet, mode] : octets) {
+    m.mode(octet);
+    services::fromMsg(m, &c);
+    EXPECT_EQ(c.mode, mode) << "octet " << int(octet);
+    EXPECT_EQ(c.z_cmd, 0.41);
+    EXPECT_EQ(c.v_cmd, 0.25);
+  }
+}
+
+TEST(Convert, WbcDiagnosticsToMsg) {
+  wbc::WbcDiagnostics d;
+  d.tick = 42;
+  d.solve_time_us = 3.5;
+  d.tick_time_us = 12.25;
+  d.iterations = 7;
+  d.status = qp::QpStatus::Optimal;
+  d.active_constraints = 4;
+  d.slack_norm = 1e-3;
+  d.task_error = {1, 2, 3, 4, 5, 6};
+  d.lti = {0.7, 0.8};
+  d.raci = {2.5, 3.5};
+  d.safety.events = 2;
+  d.safety_mode = wbc::SafetyMode::Damping;
+  msg::WbcDiagnostics m;
+  services::toMsg(d, 42000000, &m);
+  EXPECT_EQ(m.tick(), 42u);
+  EXPECT_EQ(m.stamp_ns(), 42000000u);
+  EXPECT_EQ(m.solve_time_us(), 3.5);
+  EXPECT_EQ(m.tick_time_us(), 12.25);
+  EXPECT_EQ(m.iterations(), 7);
+  EXPECT_EQ(m.status(), static_cast<std::int32_t>(qp::QpStatus::Optimal));
+  EXPECT_EQ(m.active_constraints(), 4);
+  EXPECT_EQ(m.slack_norm(), 1e-3);
+  EXPECT_EQ(m.task_error()[5], 6.0);
+  EXPECT_EQ(m.lti()[1], 0.8);
+  EXPECT_EQ(m.raci()[0], 2.5);
+  EXPECT_EQ(m.safety_events(), 2u);
+  EXPECT_FALSE(m.holding());
+  EXPECT_TRUE(m.damping());
+}

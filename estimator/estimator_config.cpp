@@ -5,17 +5,19 @@
 namespace mft::estimator {
 namespace {
 
+using config::EnumName;
 using config::StrictNode;
+
+constexpr EnumName<EstimatorMode> kModeNames[] = {{EstimatorMode::Kalman, "kalman"},
+                                                  {EstimatorMode::GroundTruth, "ground_truth"}};
+constexpr EnumName<ContactSource> kContactSourceNames[] = {{ContactSource::Switch, "switch"},
+                                                           {ContactSource::Force, "force"},
+                                                           {ContactSource::Either, "either"},
+                                                           {ContactSource::Both, "both"}};
 
 EstimatorConfig read(StrictNode& root) {
   EstimatorConfig c;
-  c.source_file = root.file();
-  const int version = root.integer("schema_version");
-  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
-  const std::string mode = root.text("mode");
-  if (mode == "kalman") c.mode = EstimatorMode::Kalman;
-  else if (mode == "ground_truth") c.mode = EstimatorMode::GroundTruth;
-  else root.fail("mode", "expected kalman or ground_truth, got '" + mode + "'");
+  c.mode = root.choice("mode", kModeNames);
 
   auto& timing = root.child("timing");
   c.nominal_dt_s = timing.positive("nominal_dt_s");
@@ -41,12 +43,7 @@ EstimatorConfig read(StrictNode& root) {
   c.pitch.acceleration_filter_s = pitch.positive("acceleration_filter_s");
 
   auto& contact = root.child("contact");
-  const std::string source = contact.text("source");
-  if (source == "switch") c.contact.source = ContactSource::Switch;
-  else if (source == "force") c.contact.source = ContactSource::Force;
-  else if (source == "either") c.contact.source = ContactSource::Either;
-  else if (source == "both") c.contact.source = ContactSource::Both;
-  else contact.fail("source", "expected switch, force, either or both, got '" + source + "'");
+  c.contact.source = contact.choice("source", kContactSourceNames);
   c.contact.force_on_N = contact.positive("force_on_N");
   c.contact.force_off_N = contact.nonNegative("force_off_N");
   if (c.contact.force_off_N > c.contact.force_on_N) contact.fail("force_off_N", "must be <= force_on_N (hysteresis)");
@@ -54,20 +51,15 @@ EstimatorConfig read(StrictNode& root) {
   auto& gt = root.child("ground_truth");
   c.ground_truth_contact_force_N = gt.nonNegative("contact_force_N");
 
-  root.finish();
   return c;
 }
 
 }  // namespace
 
-EstimatorConfig loadEstimatorConfig(const std::string& path) {
-  auto root = StrictNode::loadFile(path);
-  return read(root);
-}
+EstimatorConfig loadEstimatorConfig(const std::string& path) { return config::loadStrictFile(path, read); }
 
 EstimatorConfig parseEstimatorConfig(const std::string& yaml_text, const std::string& origin) {
-  auto root = StrictNode::loadString(yaml_text, origin);
-  return read(root);
+  return config::parseStrictString(yaml_text, origin, read);
 }
 
 }  // namespace mft::estimator

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "model/config/enum_names.hpp"
+
 namespace mft::model {
 
 MftLegModel MftLegModel::from(const RobotDescription& d) {
@@ -83,13 +85,10 @@ Interval reachableBaseHeights(const MftLegModel& m, double foot_x_m, double step
   return out;
 }
 
-const char* fiveBarStatusName(FiveBarStatus s) {
-  switch (s) {
-    case FiveBarStatus::Ok: return "ok";
-    case FiveBarStatus::Unreachable: return "unreachable";
-    case FiveBarStatus::Degenerate: return "degenerate";
-  }
-  return "?";
-}
+constexpr config::EnumName<FiveBarStatus> kFiveBarStatusNames[] = {{FiveBarStatus::Ok, "ok"},
+                                                                   {FiveBarStatus::Unreachable, "unreachable"},
+                                                                   {FiveBarStatus::Degenerate, "degenerate"}};
+
+const char* fiveBarStatusName(FiveBarStatus s) { return config::nameOf(kFiveBarStatusNames, s); }
 
 }  // namespace mft::model

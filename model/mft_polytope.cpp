@@ -59,12 +59,6 @@ std::string rowList(const M& m, int r) {
   return list(v.data(), static_cast<int>(v.size()));
 }
 
-Interval readInterval(StrictNode& n, const std::string& key) {
-  const auto v = n.fixed<2>(key);
-  if (!(v[0] <= v[1])) n.fail(key, "expected [lower, upper] with lower <= upper");
-  return {v[0], v[1]};
-}
-
 // Row k of a flat row-major list.
 Eigen::RowVectorXd flatRow(const std::vector<double>& v, int k, int cols) {
   Eigen::RowVectorXd r(cols);
@@ -74,9 +68,6 @@ Eigen::RowVectorXd flatRow(const std::vector<double>& v, int k, int cols) {
 
 MftPolytope read(StrictNode& root, const RobotDescription& robot) {
   MftPolytope p;
-  p.source_file = root.file();
-  const int version = root.integer("schema_version");
-  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
 
   auto& rob = root.child("robot");
   p.robot_name = rob.text("name");
@@ -91,8 +82,8 @@ MftPolytope read(StrictNode& root, const RobotDescription& robot) {
                              ": the polytope is stale, regenerate it with `mft-space fit`");
 
   auto& th = root.child("thresholds");
-  p.criteria.lti = readInterval(th, "lti");
-  p.criteria.raci = readInterval(th, "raci_N_per_sqrt_kg");
+  p.criteria.lti = th.orderedPair<Interval>("lti", /*allow_equal=*/true);
+  p.criteria.raci = th.orderedPair<Interval>("raci_N_per_sqrt_kg", /*allow_equal=*/true);
   if (!parseRaciForm(th.text("raci_form"), &p.criteria.raci_options.form))
     th.fail("raci_form", "expected 'optimal' or 'fixed'");
   p.criteria.raci_options.accel_max_mps2 = th.positive("accel_max_mps2");
@@ -145,20 +136,17 @@ MftPolytope read(StrictNode& root, const RobotDescription& robot) {
       aug.fail("A", "row " + std::to_string(k) + " differs from blkdiag(leg_polygon.A, leg_polygon.A)");
     if (std::abs(b[k] - p.b[k]) > 1e-9) aug.fail("b", "element " + std::to_string(k) + " differs from [leg_polygon.b; leg_polygon.b]");
   }
-  root.finish();
   return p;
 }
 
 }  // namespace
 
 MftPolytope loadMftPolytope(const std::string& path, const RobotDescription& robot) {
-  auto root = StrictNode::loadFile(path);
-  return read(root, robot);
+  return config::loadStrictFile(path, [&](StrictNode& root) { return read(root, robot); });
 }
 
 MftPolytope parseMftPolytope(const std::string& text, const std::string& origin, const RobotDescription& robot) {
-  auto root = StrictNode::loadString(text, origin);
-  return read(root, robot);
+  return config::parseStrictString(text, origin, [&](StrictNode& root) { return read(root, robot); });
 }
 
 void writeMftPolytope(std::ostream& out, const MftPolytope& p, const std::vector<std::string>& header) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "model/config/enum_names.hpp"
 #include "model/mft_indices.hpp"
 
 namespace mft::model {
@@ -39,14 +40,12 @@ double optimalWithGravity(const Eigen::Vector2d& u, const Eigen::Vector2d& w, do
 }
 }  // namespace
 
-const char* raciFormName(RaciForm f) { return f == RaciForm::FixedDrive ? "fixed" : "optimal"; }
+constexpr config::EnumName<RaciForm> kRaciFormNames[] = {{RaciForm::OptimalRatio, "optimal"},
+                                                         {RaciForm::FixedDrive, "fixed"}};
 
-bool parseRaciForm(const std::string& s, RaciForm* out) {
-  if (s == "optimal") *out = RaciForm::OptimalRatio;
-  else if (s == "fixed") *out = RaciForm::FixedDrive;
-  else return false;
-  return true;
-}
+const char* raciFormName(RaciForm f) { return config::nameOf(kRaciFormNames, f); }
+
+bool parseRaciForm(const std::string& s, RaciForm* out) { return config::parseName(kRaciFormNames, s, out); }
 
 RaciOptions RaciOptions::fromRobot(const RobotDescription& d) {
   RaciOptions o;

@@ -27,12 +27,6 @@ LinkParams readLink(StrictNode& n, const char* com_key) {
   return l;
 }
 
-Interval readInterval(StrictNode& n, const std::string& key) {
-  const auto v = n.fixed<2>(key);
-  if (!(v[0] < v[1])) n.fail(key, "expected [lower, upper] with lower < upper");
-  return {v[0], v[1]};
-}
-
 // FNV-1a over the canonical bytes of every value: stable across formatting and comments.
 struct Hasher {
   std::uint64_t h = 1469598103934665603ull;
@@ -74,9 +68,6 @@ std::uint64_t computeChecksum(const RobotDescription& d) {
 
 RobotDescription read(StrictNode& root) {
   RobotDescription d;
-  d.source_file = root.file();
-  const int version = root.integer("schema_version");
-  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
   d.name = root.text("name");
   d.gravity_mps2 = root.inRange("gravity_mps2", 1.0, 30.0, "m/s^2");
 
@@ -96,10 +87,10 @@ RobotDescription read(StrictNode& root) {
     leg.fail("shank.length_m", "two shanks must span the hip spacing for the legs to close");
 
   auto& lim = root.child("joint_limits");
-  d.rear_hip_rad = readInterval(lim, "rear_hip_rad");
-  d.fore_hip_rad = readInterval(lim, "fore_hip_rad");
-  d.rear_knee_rad = readInterval(lim, "rear_knee_rad");
-  d.fore_knee_rad = readInterval(lim, "fore_knee_rad");
+  d.rear_hip_rad = lim.orderedPair<Interval>("rear_hip_rad");
+  d.fore_hip_rad = lim.orderedPair<Interval>("fore_hip_rad");
+  d.rear_knee_rad = lim.orderedPair<Interval>("rear_knee_rad");
+  d.fore_knee_rad = lim.orderedPair<Interval>("fore_knee_rad");
   if (d.rear_hip_rad.lo < -M_PI || d.rear_hip_rad.hi > M_PI)
     lim.fail("rear_hip_rad", "hip limits must lie in [-pi, pi]");
   if (d.fore_hip_rad.lo < -M_PI || d.fore_hip_rad.hi > M_PI)
@@ -127,21 +118,16 @@ RobotDescription read(StrictNode& root) {
   d.contact_stiffness_Npm = contact.inRange("stiffness_Npm", 100.0, 1e9, "N/m");
   d.contact_damping_Nspm = contact.inRange("damping_Nspm", 0.0, 1e7, "N s/m");
 
-  root.finish();
   d.checksum = computeChecksum(d);
   return d;
 }
 
 }  // namespace
 
-RobotDescription loadRobotDescription(const std::string& path) {
-  auto root = StrictNode::loadFile(path);
-  return read(root);
-}
+RobotDescription loadRobotDescription(const std::string& path) { return config::loadStrictFile(path, read); }
 
 RobotDescription parseRobotDescription(const std::string& yaml_text, const std::string& origin) {
-  auto root = StrictNode::loadString(yaml_text, origin);
-  return read(root);
+  return config::parseStrictString(yaml_text, origin, read);
 }
 
 std::string checksumHex(std::uint64_t checksum) {

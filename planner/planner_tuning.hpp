@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "model/config/live_tuning.hpp"
 #include "planner/planner_config.hpp"
 
 namespace mft::planner {
@@ -17,12 +18,7 @@ struct PlannerTuning {
 };
 inline PlannerTuning tuningOf(const PlannerConfig& c) { return {c.swing, c.placement, c.command.height_rate_mps}; }
 
-struct PlannerOverride {
-  PlannerConfig config;          // the configuration with the change, as the strict loader read it
-  std::string yaml_text;         // its YAML (the base of the next change)
-  std::vector<double> value;     // the new value as loaded
-  std::vector<double> previous;  // the value before the change
-};
+using PlannerOverride = config::ConfigOverride<PlannerConfig>;
 
 // Sets `key` of config/planner.yaml to `value_yaml` in `yaml_text` (named `origin` in messages) and loads the
 // result with parsePlannerConfig. Throws config::ConfigError with the loader's message for an unknown key or an

@@ -5,24 +5,24 @@
 namespace mft::sim {
 namespace {
 
+using config::EnumName;
 using config::StrictNode;
+
+constexpr EnumName<LoopClosureJoint> kLoopClosureNames[] = {{LoopClosureJoint::Ball, "ball"},
+                                                            {LoopClosureJoint::Hinge, "hinge"}};
+constexpr EnumName<ActuatorModel> kActuatorModelNames[] = {{ActuatorModel::Sea, "sea"},
+                                                           {ActuatorModel::SeaMotor, "sea_motor"},
+                                                           {ActuatorModel::Ideal, "ideal"}};
 
 SimOptions read(StrictNode& root) {
   SimOptions o;
-  o.source_file = root.file();
-  const int version = root.integer("schema_version");
-  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
   o.control_period_s = root.inRange("control_period_s", 1e-6, 0.1);
-  o.substeps = root.integer("substeps");
-  if (o.substeps < 1 || o.substeps > 100) root.fail("substeps", "must lie in [1, 100]");
+  o.substeps = root.integerInRange("substeps", 1, 100);
 
   auto& world = root.child("world");
   o.erp = world.inRange("erp", 0.0, 1.0);
   o.cfm = world.inRange("cfm", 0.0, 1e-3);
-  const std::string closure = world.text("loop_closure");
-  if (closure == "ball") o.loop_closure = LoopClosureJoint::Ball;
-  else if (closure == "hinge") o.loop_closure = LoopClosureJoint::Hinge;
-  else world.fail("loop_closure", "expected ball or hinge, got '" + closure + "'");
+  o.loop_closure = world.choice("loop_closure", kLoopClosureNames);
   o.fix_torso = world.boolean("fix_torso");
 
   auto& contact = root.child("contact");
@@ -31,8 +31,7 @@ SimOptions read(StrictNode& root) {
   o.friction_coefficient = contact.positive("friction_coefficient");
   o.contact_stiffness_Npm = contact.positive("stiffness_Npm");
   o.contact_damping_Nspm = contact.nonNegative("damping_Nspm");
-  o.max_contacts_per_geom = contact.integer("max_contacts_per_geom");
-  if (o.max_contacts_per_geom < 1 || o.max_contacts_per_geom > 16) contact.fail("max_contacts_per_geom", "must lie in [1, 16]");
+  o.max_contacts_per_geom = contact.integerInRange("max_contacts_per_geom", 1, 16);
   o.contact_switch_threshold_N = contact.nonNegative("switch_threshold_N");
   o.link_collisions = contact.boolean("link_collisions");
   o.link_collision_radius_m = contact.inRange("link_collision_radius_m", 1e-3, 0.1);
@@ -42,11 +41,7 @@ SimOptions read(StrictNode& root) {
   o.hard_stop_damping_Nmsprad = stops.nonNegative("damping_Nmsprad");
 
   auto& act = root.child("actuators");
-  const std::string model = act.text("model");
-  if (model == "sea") o.actuator_model = ActuatorModel::Sea;
-  else if (model == "sea_motor") o.actuator_model = ActuatorModel::SeaMotor;
-  else if (model == "ideal") o.actuator_model = ActuatorModel::Ideal;
-  else act.fail("model", "expected sea, sea_motor or ideal, got '" + model + "'");
+  o.actuator_model = act.choice("model", kActuatorModelNames);
   o.speed_limit_band_radps = act.positive("speed_limit_band_radps");
   o.damping_mode_gain_Nmsprad = act.nonNegative("damping_mode_gain_Nmsprad");
   auto& motor = act.child("sea_motor");
@@ -55,9 +50,7 @@ SimOptions read(StrictNode& root) {
 
   auto& noise = root.child("noise");
   o.noise.enabled = noise.boolean("enabled");
-  const int seed = noise.integer("seed");
-  if (seed < 0) noise.fail("seed", "must be >= 0");
-  o.noise.seed = static_cast<std::uint64_t>(seed);
+  o.noise.seed = static_cast<std::uint64_t>(noise.nonNegativeInteger("seed"));
   o.noise.encoder_position_std_rad = noise.nonNegative("encoder_position_std_rad");
   o.noise.encoder_velocity_std_radps = noise.nonNegative("encoder_velocity_std_radps");
   o.noise.sea_torque_std_Nm = noise.nonNegative("sea_torque_std_Nm");
@@ -66,20 +59,15 @@ SimOptions read(StrictNode& root) {
   o.noise.accel_std_mps2 = noise.nonNegative("accel_std_mps2");
   o.noise.accel_bias_mps2 = noise.fixed<2>("accel_bias_mps2");
 
-  root.finish();
   return o;
 }
 
 }  // namespace
 
-SimOptions loadSimOptions(const std::string& path) {
-  auto root = StrictNode::loadFile(path);
-  return read(root);
-}
+SimOptions loadSimOptions(const std::string& path) { return config::loadStrictFile(path, read); }
 
 SimOptions parseSimOptions(const std::string& yaml_text, const std::string& origin) {
-  auto root = StrictNode::loadString(yaml_text, origin);
-  return read(root);
+  return config::parseStrictString(yaml_text, origin, read);
 }
 
 }  // namespace mft::sim

@@ -12,7 +12,13 @@ namespace mft::sim {
 namespace {
 
 using config::ConfigError;
+using config::EnumName;
 using config::StrictNode;
+
+constexpr EnumName<SegmentType> kSegmentTypeNames[] = {{SegmentType::Flat, "flat"},
+                                                       {SegmentType::Board, "board"},
+                                                       {SegmentType::Slope, "slope"},
+                                                       {SegmentType::Rough, "rough"}};
 
 // StrictNode reads mappings only; a list of segments is split into one strict mapping per entry.
 StrictNode strictFromYaml(const YAML::Node& node, const std::string& origin) {
@@ -28,20 +34,16 @@ TerrainSegment readSegment(StrictNode& n, double x0, double z0) {
   const std::string type = n.text("type");
   s.length = n.inRange("length_m", 1e-3, 1e4);
   if (n.has("friction")) s.friction = n.inRange("friction", 0.0, 10.0);
-  if (type == "flat") {
-    s.type = SegmentType::Flat;
-  } else if (type == "board") {
-    s.type = SegmentType::Board;
+  if (!config::parseName(kSegmentTypeNames, type, &s.type))
+    n.fail("type", "expected " + config::nameList(kSegmentTypeNames) + ", got '" + type + "'");
+  if (s.type == SegmentType::Board) {
     s.height = n.inRange("height_m", 1e-4, 1.0);
-  } else if (type == "slope") {
-    s.type = SegmentType::Slope;
+  } else if (s.type == SegmentType::Slope) {
     s.angle_rad = n.inRange("angle_deg", -45.0, 45.0) * M_PI / 180.0;
-  } else if (type == "rough") {
-    s.type = SegmentType::Rough;
+  } else if (s.type == SegmentType::Rough) {
     const double amplitude = n.inRange("amplitude_m", 0.0, 0.5);
     const double spacing = n.inRange("spacing_m", 1e-3, 10.0);
-    const int seed = n.integer("seed");
-    if (seed < 0) n.fail("seed", "must be >= 0");
+    const int seed = n.nonNegativeInteger("seed");
     const int cells = std::max(2, static_cast<int>(std::lround(s.length / spacing)));
     s.spacing = s.length / cells;
     SplitMix64 rng(static_cast<std::uint64_t>(seed));
@@ -49,8 +51,6 @@ TerrainSegment readSegment(StrictNode& n, double x0, double z0) {
     for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i] = amplitude * rng.uniform();
     s.samples.front() = 0.0;  // join the level ground on both sides
     s.samples.back() = 0.0;
-  } else {
-    n.fail("type", "expected flat, board, slope or rough, got '" + type + "'");
   }
   n.finish();
   return s;
@@ -66,8 +66,7 @@ Terrain read(const YAML::Node& root, const std::string& origin) {
   Terrain t;
   t.source_file = origin;
   auto head = strictFromYaml(top, origin);
-  const int version = head.integer("schema_version");
-  if (version != 1) head.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
+  head.expectSchemaVersion(1);
   t.start_x = head.number("start_x_m");
   t.start_height = head.number("start_height_m");
   head.finish();
@@ -84,15 +83,7 @@ Terrain read(const YAML::Node& root, const std::string& origin) {
 
 }  // namespace
 
-const char* segmentTypeName(SegmentType t) {
-  switch (t) {
-    case SegmentType::Flat: return "flat";
-    case SegmentType::Board: return "board";
-    case SegmentType::Slope: return "slope";
-    case SegmentType::Rough: return "rough";
-  }
-  return "?";
-}
+const char* segmentTypeName(SegmentType t) { return config::nameOf(kSegmentTypeNames, t); }
 
 double TerrainSegment::endLevel() const {
   return type == SegmentType::Slope ? z0 + length * std::tan(angle_rad) : z0;
@@ -133,26 +124,10 @@ Terrain Terrain::flat() {
   return t;
 }
 
-Terrain loadTerrain(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path + ": cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path + ": not valid YAML: " + e.what());
-  }
-  return read(root, path);
-}
+Terrain loadTerrain(const std::string& path) { return read(config::readYamlFile(path), path); }
 
 Terrain parseTerrain(const std::string& yaml_text, const std::string& origin) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(origin + ": not valid YAML: " + e.what());
-  }
-  return read(root, origin);
+  return read(config::readYamlText(yaml_text, origin), origin);
 }
 
 }  // namespace mft::sim

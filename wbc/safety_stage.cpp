@@ -3,28 +3,22 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/config/enum_names.hpp"
+
 namespace mft::wbc {
 
-const char* toString(SafetyMode m) {
-  switch (m) {
-    case SafetyMode::Normal: return "normal";
-    case SafetyMode::Holding: return "holding";
-    case SafetyMode::Damping: return "damping";
-  }
-  return "?";
-}
+constexpr config::EnumName<SafetyMode> kSafetyModeNames[] = {
+    {SafetyMode::Normal, "normal"}, {SafetyMode::Holding, "holding"}, {SafetyMode::Damping, "damping"}};
+constexpr config::EnumName<SafetyEvent> kSafetyEventNames[] = {{SafetyEvent::None, "none"},
+                                                               {SafetyEvent::NonFiniteInput, "non-finite input"},
+                                                               {SafetyEvent::ModelFailure, "model failure"},
+                                                               {SafetyEvent::SolverFailure, "solver failure"},
+                                                               {SafetyEvent::NonFiniteOutput, "non-finite output"},
+                                                               {SafetyEvent::Exception, "exception"}};
 
-const char* toString(SafetyEvent e) {
-  switch (e) {
-    case SafetyEvent::None: return "none";
-    case SafetyEvent::NonFiniteInput: return "non-finite input";
-    case SafetyEvent::ModelFailure: return "model failure";
-    case SafetyEvent::SolverFailure: return "solver failure";
-    case SafetyEvent::NonFiniteOutput: return "non-finite output";
-    case SafetyEvent::Exception: return "exception";
-  }
-  return "?";
-}
+const char* toString(SafetyMode m) { return config::nameOf(kSafetyModeNames, m); }
+
+const char* toString(SafetyEvent e) { return config::nameOf(kSafetyEventNames, e); }
 
 SafetyStage::SafetyStage(int hold_ticks, double damping_gain, const model::VectorA& tau_max, bool latch_damping)
     : hold_ticks_(hold_ticks), damping_gain_(damping_gain), tau_max_(tau_max), latch_damping_(latch_damping) {}

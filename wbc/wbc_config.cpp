@@ -25,20 +25,14 @@ PdGains2 readGains2(StrictNode& n) {
   return g;
 }
 
-model::Interval readInterval(StrictNode& n, const std::string& key) {
-  const auto v = n.fixed<2>(key);
-  if (!(v[0] < v[1])) n.fail(key, "expected [lower, upper] with lower < upper");
-  return {v[0], v[1]};
-}
+constexpr config::EnumName<WbcVariant> kVariantNames[] = {
+    {WbcVariant::Mft, "mft"}, {WbcVariant::Sa, "sa"}, {WbcVariant::None, "none"}};
 
 WbcConfig read(StrictNode& root) {
   WbcConfig c;
-  c.source_file = root.file();
-  const int version = root.integer("schema_version");
-  if (version != 1) root.fail("schema_version", "unsupported version " + std::to_string(version) + " (expected 1)");
   const std::string variant = root.text("variant");
   if (!parseVariant(variant, &c.variant))
-    root.fail("variant", "unknown variant '" + variant + "' (expected one of: mft, sa, none)");
+    root.fail("variant", "unknown variant '" + variant + "' (expected one of: " + config::nameList(kVariantNames, ", ") + ")");
   c.horizon_settling_times = root.positive("horizon_settling_times");
 
   auto& w = root.child("weights");
@@ -73,48 +67,27 @@ WbcConfig read(StrictNode& root) {
   c.contact.normal_force_max_N = ct.positive("normal_force_max_N");
 
   auto& sa = root.child("sa");
-  c.sa.rear_knee_rad = readInterval(sa, "rear_knee_rad");
-  c.sa.fore_knee_rad = readInterval(sa, "fore_knee_rad");
+  c.sa.rear_knee_rad = sa.orderedPair<model::Interval>("rear_knee_rad");
+  c.sa.fore_knee_rad = sa.orderedPair<model::Interval>("fore_knee_rad");
 
   auto& s = root.child("safety");
-  c.safety.hold_ticks = s.integer("hold_ticks");
-  if (c.safety.hold_ticks < 0) s.fail("hold_ticks", "must be >= 0");
+  c.safety.hold_ticks = s.nonNegativeInteger("hold_ticks");
   c.safety.damping_Nms_per_rad = s.nonNegative("damping_Nms_per_rad");
   c.safety.latch_damping = s.boolean("latch_damping");
 
-  root.finish();
   return c;
 }
 
 }  // namespace
 
-const char* toString(WbcVariant v) {
-  switch (v) {
-    case WbcVariant::Mft: return "mft";
-    case WbcVariant::Sa: return "sa";
-    case WbcVariant::None: return "none";
-  }
-  return "?";
-}
+const char* toString(WbcVariant v) { return config::nameOf(kVariantNames, v); }
 
-bool parseVariant(const std::string& text, WbcVariant* out) {
-  for (WbcVariant v : {WbcVariant::Mft, WbcVariant::Sa, WbcVariant::None}) {
-    if (text == toString(v)) {
-      *out = v;
-      return true;
-    }
-  }
-  return false;
-}
+bool parseVariant(const std::string& text, WbcVariant* out) { return config::parseName(kVariantNames, text, out); }
 
-WbcConfig loadWbcConfig(const std::string& path) {
-  StrictNode root = StrictNode::loadFile(path);
-  return read(root);
-}
+WbcConfig loadWbcConfig(const std::string& path) { return config::loadStrictFile(path, read); }
 
 WbcConfig parseWbcConfig(const std::string& yaml_text, const std::string& origin) {
-  StrictNode root = StrictNode::loadString(yaml_text, origin);
-  return read(root);
+  return config::parseStrictString(yaml_text, origin, read);
 }
 
 void validateWbcConfig(const WbcConfig& c, const model::RobotDescription& robot) {

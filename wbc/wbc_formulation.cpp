@@ -5,6 +5,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "model/config/enum_names.hpp"
+
 namespace mft::wbc {
 namespace {
 
@@ -75,12 +77,9 @@ Task identityTask(const char* name, VarBlock block, const WbcWeights& w, double 
 }  // namespace
 
 const char* toString(VarBlock b) {
-  switch (b) {
-    case VarBlock::Qdd: return "qdd";
-    case VarBlock::Fc: return "f_c";
-    case VarBlock::Eps: return "eps";
-  }
-  return "?";
+  static constexpr config::EnumName<VarBlock> kNames[] = {
+      {VarBlock::Qdd, "qdd"}, {VarBlock::Fc, "f_c"}, {VarBlock::Eps, "eps"}};
+  return config::nameOf(kNames, b);
 }
 
 WbcParams makeWbcParams(const model::RobotDescription& robot, const WbcConfig& config, const WbcPolytope* polytope) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "model/robot_description.hpp"
+#include "model/config/live_tuning.hpp"
 #include "wbc/wbc_config.hpp"
 
 namespace mft::wbc {
@@ -18,12 +19,7 @@ struct WbcTuning {
 };
 inline WbcTuning tuningOf(const WbcConfig& c) { return {c.weights, c.gains}; }
 
-struct WbcOverride {
-  WbcConfig config;             // the configuration with the change, as the strict loader read it
-  std::string yaml_text;        // its YAML (the base of the next change)
-  std::vector<double> value;    // the new value as loaded (1 or 2 numbers)
-  std::vector<double> previous; // the value before the change
-};
+using WbcOverride = config::ConfigOverride<WbcConfig>;
 
 // Sets `key` (a dotted key of config/wbc.yaml, e.g. "weights.slack") to `value_yaml` in `yaml_text` (the
 // configuration in force, named `origin` in messages) and loads the result with parseWbcConfig and

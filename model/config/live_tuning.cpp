@@ -147,4 +147,9 @@ std::string formatNumbers(const double* values, std::size_t count) {
   return out + "]";
 }
 
+void requireTunable(const std::string& stem, const std::string& key, const std::string& origin) {
+  if (tunableIndex(stem, key) < 0)
+    throw ConfigError(origin + ": " + key + ": not tunable while the stack runs (tunable: " + describeTunable(stem) + ")");
+}
+
 }  // namespace mft::config

@@ -33,4 +33,30 @@ std::vector<double> numbersAt(const std::string& yaml_text, const std::string& d
 // "1000" or "[300, 300]" (shortest text that reads back to the same doubles).
 std::string formatNumbers(const double* values, std::size_t count);
 
+// A live change judged: the configuration with it, as the file's strict loader read it, and the value before and
+// after.
+template <class Config>
+struct ConfigOverride {
+  Config config;                 // the configuration with the change, as the strict loader read it
+  std::string yaml_text;         // its YAML (the base of the next change)
+  std::vector<double> value;     // the new value as loaded (1 or 2 numbers)
+  std::vector<double> previous;  // the value before the change
+};
+// Refuses a `key` of file `stem` that is not tunable live (ConfigError naming the tunable keys).
+void requireTunable(const std::string& stem, const std::string& key, const std::string& origin);
+// Sets `key` to `value_yaml` in `yaml_text` (named `origin` in messages), reads the result with `load(text,
+// origin)` (the file's strict loader: its ConfigError for an unknown key or an invalid value), then requires the
+// key to be tunable.
+template <class Config, class Load>
+ConfigOverride<Config> applyOverride(const std::string& stem, const std::string& yaml_text, const std::string& origin,
+                                     const std::string& key, const std::string& value_yaml, Load load) {
+  ConfigOverride<Config> out;
+  out.yaml_text = setKey(yaml_text, key, value_yaml, origin);
+  out.config = load(out.yaml_text, origin);
+  requireTunable(stem, key, origin);
+  out.value = numbersAt(out.yaml_text, key);
+  out.previous = numbersAt(yaml_text, key);
+  return out;
+}
+
 }  // namespace mft::config

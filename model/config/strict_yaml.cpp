@@ -28,14 +28,28 @@ StrictNode::StrictNode(StrictNode&&) noexcept = default;
 StrictNode& StrictNode::operator=(StrictNode&&) noexcept = default;
 StrictNode::~StrictNode() = default;
 
-StrictNode StrictNode::loadString(const std::string& text, const std::string& origin) {
-  auto impl = std::make_unique<Impl>();
-  impl->file = origin;
+YAML::Node readYamlText(const std::string& text, const std::string& origin) {
   try {
-    impl->node = YAML::Load(text);
+    return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ": not valid YAML: " + e.what());
   }
+}
+
+YAML::Node readYamlFile(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path + ": cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path + ": not valid YAML: " + e.what());
+  }
+}
+
+StrictNode StrictNode::loadString(const std::string& text, const std::string& origin) {
+  auto impl = std::make_unique<Impl>();
+  impl->file = origin;
+  impl->node = readYamlText(text, origin);
   if (!impl->node.IsMap()) throw ConfigError(origin + ": expected a mapping of keys at the top level");
   return StrictNode(std::move(impl));
 }
@@ -45,13 +59,7 @@ StrictNode StrictNode::loadFile(const std::string& path) {
   impl->file = path;
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw ConfigError(path + ": is a directory, not a YAML file");
-  try {
-    impl->node = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path + ": cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path + ": not valid YAML: " + e.what());
-  }
+  impl->node = readYamlFile(path);
   if (!impl->node.IsMap()) throw ConfigError(path + ": expected a mapping of keys at the top level");
   // The active profiles (profiles.hpp) change the configuration files they name, for every loader alike.
   const ProfileSet& profiles = activeProfiles();
@@ -77,29 +85,42 @@ std::vector<std::string> StrictNode::keys() const {
   return k;
 }
 
-StrictNode& StrictNode::child(const std::string& key) {
-  auto it = impl_->children.find(key);
-  if (it != impl_->children.end()) return *it->second;
+YAML::Node StrictNode::take(const std::string& key, Shape shape, const std::string& expected) {
   const YAML::Node n = impl_->node[key];
   if (!n) fail(key, "missing key");
-  if (!n.IsMap()) fail(key, "expected a mapping");
+  const bool fits = shape == Shape::Scalar ? n.IsScalar() : shape == Shape::List ? n.IsSequence() : n.IsMap();
+  if (!fits) fail(key, expected);
   impl_->used.insert(key);
+  return n;
+}
+
+template <class T>
+T StrictNode::scalar(const std::string& key, const std::string& expected) {
+  const YAML::Node n = take(key, Shape::Scalar, expected);
+  try {
+    return n.as<T>();
+  } catch (const YAML::Exception&) {
+    fail(key, expected + ", got '" + n.Scalar() + "'");
+  }
+}
+
+StrictNode& StrictNode::addChild(const std::string& name, const YAML::Node& node) {
   auto impl = std::make_unique<Impl>();
-  impl->node = n;
+  impl->node = node;
   impl->file = impl_->file;
-  impl->path = join(impl_->path, key);
-  auto& slot = impl_->children[key];
+  impl->path = join(impl_->path, name);
+  auto& slot = impl_->children[name];
   slot.reset(new StrictNode(std::move(impl)));
   return *slot;
 }
 
-std::size_t StrictNode::listSize(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsSequence()) fail(key, "expected a list");
-  impl_->used.insert(key);
-  return n.size();
+StrictNode& StrictNode::child(const std::string& key) {
+  auto it = impl_->children.find(key);
+  if (it != impl_->children.end()) return *it->second;
+  return addChild(key, take(key, Shape::Mapping, "expected a mapping"));
 }
+
+std::size_t StrictNode::listSize(const std::string& key) { return take(key, Shape::List, "expected a list").size(); }
 
 StrictNode& StrictNode::item(const std::string& key, std::size_t index) {
   const std::string name = key + "[" + std::to_string(index) + "]";
@@ -108,26 +129,11 @@ StrictNode& StrictNode::item(const std::string& key, std::size_t index) {
   if (index >= listSize(key)) fail(name, "no such list element");
   const YAML::Node n = impl_->node[key][index];
   if (!n.IsMap()) fail(name, "expected a mapping");
-  auto impl = std::make_unique<Impl>();
-  impl->node = n;
-  impl->file = impl_->file;
-  impl->path = join(impl_->path, name);
-  auto& slot = impl_->children[name];
-  slot.reset(new StrictNode(std::move(impl)));
-  return *slot;
+  return addChild(name, n);
 }
 
 double StrictNode::number(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsScalar()) fail(key, "expected a number");
-  impl_->used.insert(key);
-  double v = 0.0;
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    fail(key, "expected a number, got '" + n.Scalar() + "'");
-  }
+  const double v = scalar<double>(key, "expected a number");
   if (!std::isfinite(v)) fail(key, "must be finite");
   return v;
 }
@@ -170,43 +176,40 @@ std::vector<double> StrictNode::numbersInRange(const std::string& key, std::size
   return v;
 }
 
-int StrictNode::integer(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsScalar()) fail(key, "expected an integer");
-  impl_->used.insert(key);
-  try {
-    return n.as<int>();
-  } catch (const YAML::Exception&) {
-    fail(key, "expected an integer, got '" + n.Scalar() + "'");
-  }
+int StrictNode::integer(const std::string& key) { return scalar<int>(key, "expected an integer"); }
+
+bool StrictNode::boolean(const std::string& key) { return scalar<bool>(key, "expected true or false"); }
+
+void StrictNode::expectSchemaVersion(int expected) {
+  const int version = integer("schema_version");
+  if (version != expected)
+    fail("schema_version",
+         "unsupported version " + std::to_string(version) + " (expected " + std::to_string(expected) + ")");
 }
 
-bool StrictNode::boolean(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsScalar()) fail(key, "expected true or false");
-  impl_->used.insert(key);
-  try {
-    return n.as<bool>();
-  } catch (const YAML::Exception&) {
-    fail(key, "expected true or false, got '" + n.Scalar() + "'");
-  }
+int StrictNode::integerInRange(const std::string& key, int lo, int hi) {
+  const int v = integer(key);
+  if (v < lo || v > hi) fail(key, "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return v;
 }
 
-std::string StrictNode::text(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsScalar()) fail(key, "expected a string");
-  impl_->used.insert(key);
-  return n.Scalar();
+int StrictNode::nonNegativeInteger(const std::string& key) {
+  const int v = integer(key);
+  if (v < 0) fail(key, "must be >= 0");
+  return v;
 }
+
+std::array<double, 2> StrictNode::orderedNumberPair(const std::string& key, bool allow_equal) {
+  const auto v = fixed<2>(key);
+  if (allow_equal ? !(v[0] <= v[1]) : !(v[0] < v[1]))
+    fail(key, allow_equal ? "expected [lower, upper] with lower <= upper" : "expected [lower, upper] with lower < upper");
+  return v;
+}
+
+std::string StrictNode::text(const std::string& key) { return take(key, Shape::Scalar, "expected a string").Scalar(); }
 
 std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expected_size) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsSequence()) fail(key, "expected a list of numbers");
-  impl_->used.insert(key);
+  const YAML::Node n = take(key, Shape::List, "expected a list of numbers");
   if (expected_size != 0 && n.size() != expected_size)
     fail(key, "expected " + std::to_string(expected_size) + " numbers, got " + std::to_string(n.size()));
   std::vector<double> out;
@@ -225,10 +228,7 @@ std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expe
 }
 
 std::vector<std::string> StrictNode::texts(const std::string& key) {
-  const YAML::Node n = impl_->node[key];
-  if (!n) fail(key, "missing key");
-  if (!n.IsSequence()) fail(key, "expected a list of strings");
-  impl_->used.insert(key);
+  const YAML::Node n = take(key, Shape::List, "expected a list of strings");
   std::vector<std::string> out;
   for (std::size_t i = 0; i < n.size(); ++i) {
     if (!n[i].IsScalar()) fail(key, "element " + std::to_string(i) + " is not a string");

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "model/config/enum_names.hpp"
+
 namespace YAML {
 class Node;
 }
@@ -49,6 +51,27 @@ class StrictNode {
   double inRange(const std::string& key, double lo, double hi, const std::string& unit = "");
   int integer(const std::string& key);
   bool boolean(const std::string& key);
+  // "schema_version" must be `expected`, else "unsupported version v (expected e)".
+  void expectSchemaVersion(int expected);
+  // An integer in [lo, hi], else "must lie in [lo, hi]".
+  int integerInRange(const std::string& key, int lo, int hi);
+  // An integer >= 0, else "must be >= 0".
+  int nonNegativeInteger(const std::string& key);
+  // [lower, upper] with lower < upper (lower <= upper when allow_equal), else "expected [lower, upper] with ...",
+  // returned as Bounds{lower, upper} (e.g. model::Interval).
+  template <class Bounds = std::array<double, 2>>
+  Bounds orderedPair(const std::string& key, bool allow_equal = false) {
+    const auto v = orderedNumberPair(key, allow_equal);
+    return Bounds{v[0], v[1]};
+  }
+  // One of the names in `table` (enum_names.hpp), else "expected a, b or c, got 'x'".
+  template <class E, std::size_t N>
+  E choice(const std::string& key, const EnumName<E> (&table)[N]) {
+    const std::string name = text(key);
+    E value{};
+    if (!parseName(table, name, &value)) fail(key, "expected " + nameList(table) + ", got '" + name + "'");
+    return value;
+  }
   std::string text(const std::string& key);
   std::vector<double> numbers(const std::string& key, std::size_t expected_size);  // 0 = any size
   std::vector<std::string> texts(const std::string& key);  // a list of strings
@@ -82,8 +105,45 @@ class StrictNode {
 
  private:
   struct Impl;
+  enum class Shape { Scalar, List, Mapping };
+  // The node at `key`, marked as read: "missing key" when absent, `expected` when not of `shape`.
+  YAML::Node take(const std::string& key, Shape shape, const std::string& expected);
+  // A scalar converted to T: `expected` when it is not a scalar, "<expected>, got 'text'" when it does not convert.
+  template <class T>
+  T scalar(const std::string& key, const std::string& expected);
+  // Keeps the child mapping `name` (a key, or key[i] of a list) over `node`; finished with this node.
+  StrictNode& addChild(const std::string& name, const YAML::Node& node);
+  std::array<double, 2> orderedNumberPair(const std::string& key, bool allow_equal);
   explicit StrictNode(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
+
+// Every configuration type has a loader from a file and a parser of text, both running one reader
+// (`read(StrictNode&)`, returning the configuration) over the strict root mapping: every file is at schema
+// version 1, any key the reader left unread is an error, and the configuration's `source_file` names the file
+// as messages do.
+template <class Read>
+auto readStrict(StrictNode& root, Read&& read) {
+  root.expectSchemaVersion(1);
+  auto result = read(root);
+  result.source_file = root.file();
+  root.finish();
+  return result;
+}
+template <class Read>
+auto loadStrictFile(const std::string& path, Read&& read) {
+  StrictNode root = StrictNode::loadFile(path);
+  return readStrict(root, read);
+}
+template <class Read>
+auto parseStrictString(const std::string& text, const std::string& origin, Read&& read) {
+  StrictNode root = StrictNode::loadString(text, origin);
+  return readStrict(root, read);
+}
+
+// The plain YAML document of a file or a text, with the same ConfigError messages as StrictNode::loadFile
+// and loadString ("cannot open the file", "not valid YAML: ..."), for readers that reshape the document.
+YAML::Node readYamlFile(const std::string& path);
+YAML::Node readYamlText(const std::string& text, const std::string& origin);
 
 }  // namespace mft::config

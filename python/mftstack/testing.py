@@ -18,7 +18,36 @@ from .paths import DEFAULT_BIN as BIN
 from .paths import DEFAULT_CONFIG as CONFIG
 from .paths import REPO, SCENARIOS, SUPERVISOR
 
-__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "pid_alive"]
+__all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "StackUpTestCase", "mft_cmd",
+           "pid_alive", "processes_mentioning"]
+
+
+def mft_cmd(domain, *args, timeout=60):
+    """Runs mft-cmd --json on `domain`; returns (exit code, parsed JSON or None, stderr, wall seconds)."""
+    t0 = time.monotonic()
+    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
+                       capture_output=True, text=True, timeout=timeout)
+    try:
+        result = json.loads(p.stdout)
+    except ValueError:
+        result = None
+    return p.returncode, result, p.stderr, time.monotonic() - t0
+
+
+def processes_mentioning(text):
+    """[(pid, command line)] of the processes whose command line mentions text (a test's own folders): what a
+    test left running."""
+    found = []
+    for p in Path("/proc").iterdir():
+        if not p.name.isdigit() or int(p.name) == os.getpid():
+            continue
+        try:
+            cmd = (p / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if text in cmd:
+            found.append((int(p.name), cmd[:200]))
+    return found
 
 
 def pid_alive(pid):
@@ -159,3 +188,34 @@ class StackTestCase(unittest.TestCase):
         self.stacks = StackRunner(prefix=self.tmp_prefix)
         self.tmp = self.stacks.path
         self.addCleanup(self.stacks.close)
+
+
+class StackUpTestCase(unittest.TestCase):
+    """One stack `up` for all tests of the class (class attributes: stack_scenario, stack_domain, stack_args, and
+    tmp_prefix), taken down after the last. A failed `up` fails every test with its message instead of erroring
+    the class; cls.stacks, cls.run_dir (when stack_run_dir) and cls.status are set for the tests."""
+
+    tmp_prefix = "mft-test-"
+    stack_scenario = "step-in-place.yaml"
+    stack_domain = None
+    stack_args = ("--mode", "realtime")
+    stack_run_dir = False  # True: the run folder is <tmp>/run (cls.run_dir)
+
+    @classmethod
+    def setUpClass(cls):
+        cls.stacks = StackRunner(prefix=cls.tmp_prefix)
+        cls.run_dir = cls.stacks.path / "run" if cls.stack_run_dir else None
+        cls.status, cls.up_error = None, None
+        try:
+            cls.status = cls.stacks.up(cls.stack_scenario, cls.stack_domain, *cls.stack_args,
+                                       *(["--run-dir", cls.run_dir] if cls.run_dir else []), timeout=180)
+        except AssertionError as e:
+            cls.up_error = str(e)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.stacks.close()
+
+    def setUp(self):
+        if self.up_error:
+            self.fail(self.up_error)

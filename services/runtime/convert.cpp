@@ -92,7 +92,10 @@ void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out) {
 void toMsg(const planner::PlanOutput& in, msg::Reference* out) {
   // The controller's part goes through the shared mapping (wbc/reference_from_plan.hpp), the one the
   // in-process closed loop uses too; the rest is schedule information for recording.
-  const wbc::WbcReference r = wbc::referenceFromPlan(in);
+  toMsg(in, wbc::referenceFromPlan(in), out);
+}
+
+void toMsg(const planner::PlanOutput& in, const wbc::WbcReference& r, msg::Reference* out) {
   out->tick(in.tick);
   out->stamp_ns(toStampNs(in.time_s));
   out->step_index(in.step_index);
@@ -118,6 +121,35 @@ void fromMsg(const msg::Reference& in, wbc::WbcReference* out) {
   copyIn(in.foot_acc(), &out->foot_acc);
   out->base_x = {in.base_x()[0], in.base_x()[1], in.base_x()[2]};
   out->hold_base_x = in.hold_base_x();
+}
+
+void toMsg(const wbc::WbcDiagnostics& in, std::uint64_t stamp_ns, msg::WbcDiagnostics* out) {
+  out->tick(in.tick);
+  out->stamp_ns(stamp_ns);
+  out->solve_time_us(in.solve_time_us);
+  out->tick_time_us(in.tick_time_us);
+  out->iterations(in.iterations);
+  out->status(static_cast<std::int32_t>(in.status));
+  out->active_constraints(in.active_constraints);
+  out->slack_norm(in.slack_norm);
+  out->task_error(in.task_error);
+  out->lti(in.lti);
+  out->raci(in.raci);
+  out->safety_events(in.safety.events);
+  out->holding(in.safety_mode == wbc::SafetyMode::Holding);
+  out->damping(in.safety_mode == wbc::SafetyMode::Damping);
+}
+
+planner::LocomotionMode locomotionModeFromMsg(std::uint8_t mode) {
+  return mode == msg::LOCOMOTION_WALK             ? planner::LocomotionMode::Walk
+         : mode == msg::LOCOMOTION_STEP_IN_PLACE ? planner::LocomotionMode::StepInPlace
+                                                  : planner::LocomotionMode::Stand;
+}
+
+void fromMsg(const msg::OperatorCommand& in, planner::OperatorCommand* out) {
+  out->z_cmd = in.z_cmd();
+  out->v_cmd = in.v_cmd();
+  out->mode = locomotionModeFromMsg(in.mode());
 }
 
 }  // namespace mft::services

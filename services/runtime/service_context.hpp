@@ -13,9 +13,6 @@
 
 namespace mft::services {
 
-// The scenario's mode type under its former name, for the mains not yet moved onto chain/ (mft-planner).
-using chain::LocomotionMode;
-
 enum class LoopMode { Lockstep, Realtime };
 
 class ServiceContext {

@@ -2,15 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <regex>
-#include <sstream>
 
 #include "estimator/contact_detector.hpp"
 #include "estimator/estimator_config.hpp"
 #include "estimator/leg_kinematics.hpp"
 #include "estimator/pitch_filter.hpp"
 #include "model/config/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using namespace mft;
 using namespace mft::estimator;
@@ -139,19 +137,8 @@ TEST(EstimatorConfig, DefaultFileLoads) {
 
 namespace {
 void expectError(const std::string& pattern, const std::string& replacement, const std::string& expect) {
-  std::ifstream in(configPath());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string bad = std::regex_replace(ss.str(), std::regex(pattern), replacement, std::regex_constants::format_first_only);
-  ASSERT_NE(bad, ss.str()) << "pattern did not match: " << pattern;
-  try {
-    parseEstimatorConfig(bad, "bad-estimator.yaml");
-    FAIL() << "expected an error containing " << expect;
-  } catch (const config::ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("bad-estimator.yaml"), std::string::npos) << msg;
-    EXPECT_NE(msg.find(expect), std::string::npos) << msg;
-  }
+  mft::test::expectConfigError(mft::test::readTextFile(configPath()), pattern, replacement, "bad-estimator.yaml",
+                               expect, parseEstimatorConfig);
 }
 }  // namespace
 

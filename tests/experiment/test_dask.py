@@ -31,7 +31,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "distributed"))
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted  # noqa: E402
-from mftstack.testing import BIN, REPO, pid_alive  # noqa: E402
+from mftstack.testing import BIN, REPO, pid_alive, processes_mentioning  # noqa: E402
 
 TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
 PY = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable
@@ -60,19 +60,6 @@ def table(out):
     with open(Path(out) / "table.csv") as f:
         return list(csv.DictReader(f))
 
-
-def processes_mentioning(text):
-    found = []
-    for p in Path("/proc").iterdir():
-        if not p.name.isdigit() or int(p.name) == os.getpid():
-            continue
-        try:
-            cmd = (p / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-        except OSError:
-            continue
-        if text in cmd:
-            found.append((int(p.name), cmd[:200]))
-    return found
 
 
 def _die_with_test():

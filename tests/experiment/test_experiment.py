@@ -7,7 +7,6 @@ re-running a finished run; and clear one-line errors on bad arguments. DDS domai
 operator_commands 90-93 and live_tuning 98-99; the integration tests take 100-219)."""
 import csv
 import json
-import os
 import shutil
 import signal
 import subprocess
@@ -19,7 +18,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import reserve_cpu_share  # noqa: E402
-from mftstack.testing import BIN, REPO  # noqa: E402
+from mftstack.testing import BIN, REPO, processes_mentioning  # noqa: E402
 
 TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
 HEIGHT = "0.44"
@@ -34,20 +33,6 @@ def tool(*args, timeout=600):
 def lines(path):
     return [json.loads(l) for l in Path(path).read_text().splitlines() if l.strip()]
 
-
-def processes_mentioning(text):
-    """pids of processes whose command line mentions text (the test's own folders)."""
-    found = []
-    for p in Path("/proc").iterdir():
-        if not p.name.isdigit() or int(p.name) == os.getpid():
-            continue
-        try:
-            cmd = (p / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-        except OSError:
-            continue
-        if text in cmd:
-            found.append((int(p.name), cmd[:200]))
-    return found
 
 
 class ExperimentTest(unittest.TestCase):

@@ -19,7 +19,8 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, SCENARIOS, StackRunner  # noqa: E402
+from mftstack import testing  # noqa: E402
+from mftstack.testing import BIN, SCENARIOS, StackRunner, StackUpTestCase  # noqa: E402
 
 DOMAIN_LOCKSTEP, DOMAIN_REALTIME = 98, 99
 AT_S = 12.0        # the change's simulated time
@@ -27,15 +28,10 @@ DURATION_S = 24.0  # of the standing run
 KP_BEFORE, KP_AFTER = 400.0, 100.0
 
 
+
 def mft_cmd(domain, *args, timeout=120):
     """mft-cmd --json; returns (exit code, parsed JSON or None, stderr)."""
-    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
-                       capture_output=True, text=True, timeout=timeout)
-    try:
-        result = json.loads(p.stdout)
-    except ValueError:
-        result = None
-    return p.returncode, result, p.stderr
+    return testing.mft_cmd(domain, *args, timeout=timeout)[:3]
 
 
 def export(rawlog, out, labels):
@@ -190,26 +186,11 @@ class LiveTuningInLockstep(unittest.TestCase):
               f"{r2['first_differing_tick']})", file=sys.stderr)
 
 
-class LiveTuningInRealtime(unittest.TestCase):
+class LiveTuningInRealtime(StackUpTestCase):
     """One realtime stack standing (`up`); the tests run in name order and the last one stops it."""
 
-    @classmethod
-    def setUpClass(cls):
-        cls.stacks = StackRunner(prefix="mft-live-tuning-rt-")
-        cls.run_dir = cls.stacks.path / "run"
-        cls.up_error = None
-        try:
-            cls.stacks.up("stand.yaml", DOMAIN_REALTIME, "--mode", "realtime", "--run-dir", cls.run_dir, timeout=180)
-        except AssertionError as e:
-            cls.up_error = str(e)
+    tmp_prefix, stack_scenario, stack_domain, stack_run_dir = "mft-live-tuning-rt-", "stand.yaml", DOMAIN_REALTIME, True
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.stacks.close()
-
-    def setUp(self):
-        if self.up_error:
-            self.fail(self.up_error)
 
     def test_1_changes_apply_at_the_next_tick(self):
         code, result, err = mft_cmd(DOMAIN_REALTIME, "--set", "wbc.weights.slack=1e5",

@@ -16,45 +16,22 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, SCENARIOS, StackRunner  # noqa: E402
+from mftstack.testing import BIN, SCENARIOS, StackUpTestCase, mft_cmd  # noqa: E402
 
 DOMAIN_STACK, DOMAIN_EMPTY, DOMAIN_LATE = 90, 91, 92
 
 
-def mft_cmd(domain, *args, timeout=60):
-    """Runs mft-cmd --json; returns (exit code, parsed JSON or None, stderr, wall seconds)."""
-    t0 = time.monotonic()
-    p = subprocess.run([str(BIN / "mft-cmd"), "--domain", str(domain), "--json"] + [str(a) for a in args],
-                       capture_output=True, text=True, timeout=timeout)
-    try:
-        result = json.loads(p.stdout)
-    except ValueError:
-        result = None
-    return p.returncode, result, p.stderr, time.monotonic() - t0
 
-
-class OperatorCommandsOnARunningStack(unittest.TestCase):
+class OperatorCommandsOnARunningStack(StackUpTestCase):
     """One realtime stack stepping in place (`up`: it runs until `down`, and on after a fall); the tests run in
     name order against it and the last one stops it and checks the services' counts."""
 
+    tmp_prefix, stack_scenario, stack_domain, stack_run_dir = "mft-opcmd-test-", "step-in-place.yaml", DOMAIN_STACK, True
+
     @classmethod
     def setUpClass(cls):
-        cls.stacks = StackRunner(prefix="mft-opcmd-test-")
-        cls.run_dir = cls.stacks.path / "run"
+        super().setUpClass()
         cls.sent = {"applied_commands": 0, "rejected_commands": 0, "pushes": []}
-        try:
-            cls.stacks.up("step-in-place.yaml", DOMAIN_STACK, "--mode", "realtime", "--run-dir", cls.run_dir, timeout=180)
-            cls.up_error = None
-        except AssertionError as e:
-            cls.up_error = str(e)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.stacks.close()
-
-    def setUp(self):
-        if self.up_error:
-            self.fail(self.up_error)
 
     def assert_applied(self, code, result, err, what):
         self.assertIsNotNone(result, f"{what}: no JSON from mft-cmd (exit {code}): {err}")

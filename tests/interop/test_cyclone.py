@@ -15,7 +15,7 @@ from pathlib import Path
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, CONFIG, StackRunner  # noqa: E402
+from mftstack.testing import BIN, CONFIG, StackUpTestCase  # noqa: E402
 
 DOMAIN = 226
 ROBOT = yaml.safe_load((CONFIG / "robot.yaml").read_text())
@@ -34,25 +34,11 @@ def cyclone(*args, timeout=90):
         return p.returncode, None, p.stderr
 
 
-class CycloneOnTheStack(unittest.TestCase):
+class CycloneOnTheStack(StackUpTestCase):
     """The tests run in name order against one stack; the last one stops it and reads the planner's counts."""
 
-    @classmethod
-    def setUpClass(cls):
-        cls.stacks = StackRunner(prefix="mft-interop-test-")
-        try:
-            cls.status = cls.stacks.up("step-in-place.yaml", DOMAIN, "--mode", "realtime")
-            cls.up_error = None
-        except AssertionError as e:
-            cls.up_error = str(e)
+    tmp_prefix, stack_scenario, stack_domain = "mft-interop-test-", "step-in-place.yaml", DOMAIN
 
-    @classmethod
-    def tearDownClass(cls):
-        cls.stacks.close()
-
-    def setUp(self):
-        if self.up_error:
-            self.fail(self.up_error)
 
     def listen(self, samples):
         code, r, err = cyclone("listen", "--domain", DOMAIN, "--min-samples", samples, "--seconds", 60)

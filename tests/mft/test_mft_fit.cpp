@@ -82,38 +82,39 @@ TEST(MftFit, VerticalStanceInsideAt038To042AndOutsideAt044And046) {
   }
 }
 
-TEST(MftFit, DiscGivesTheInscribedHexagon) {
-  // Unit disc on a 0.02 grid: the best conservative hexagon is close to the regular one (area 2.598 for r = 1).
+namespace {
+// An n x n grid of 0.02 cells from (lo, lo): preferable where `preferable(node)` holds, reachable elsewhere.
+template <class Shape>
+LabelGrid shapeGrid(double lo, int n, Shape&& preferable) {
   LabelGrid g;
-  g.x = g.y = GridAxis{-1.2, 0.02, 121};
-  g.labels.resize(121 * 121);
-  for (int j = 0; j < 121; ++j)
-    for (int i = 0; i < 121; ++i) g.labels[j * 121 + i] = g.node(i, j).norm() <= 1.0 ? kCellPreferable : kCellReachable;
-  PolygonFitOptions o;
-  const PolygonFitResult r = fitConservativePolygon(fitCellsFromGrid(g), o);
+  g.x = g.y = GridAxis{lo, 0.02, n};
+  g.labels.resize(n * n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) g.labels[j * n + i] = preferable(g.node(i, j)) ? kCellPreferable : kCellReachable;
+  return g;
+}
+
+// Fits with the default options; the polygon's area lies in (area_lo, area_hi) and it holds no bad cell.
+void expectConservativeFit(const LabelGrid& g, double area_lo, double area_hi) {
+  const PolygonFitResult r = fitConservativePolygon(fitCellsFromGrid(g), PolygonFitOptions{});
   ASSERT_TRUE(r.ok);
-  EXPECT_GT(r.area, 2.5);
-  EXPECT_LT(r.area, 2.62);
+  EXPECT_GT(r.area, area_lo);
+  EXPECT_LT(r.area, area_hi);
   EXPECT_EQ(assessPolygon(g, r.polygon).bad_inside, 0);
   EXPECT_EQ(badBoxesTouched(g, r.polygon), 0);
+}
+}  // namespace
+
+TEST(MftFit, DiscGivesTheInscribedHexagon) {
+  // Unit disc on a 0.02 grid: the best conservative hexagon is close to the regular one (area 2.598 for r = 1).
+  const LabelGrid g = shapeGrid(-1.2, 121, [](const Eigen::Vector2d& x) { return x.norm() <= 1.0; });
+  expectConservativeFit(g, 2.5, 2.62);
 }
 
 TEST(MftFit, LShapeKeepsOneArm) {
   // An L of two 2 x 0.6 arms: no convex piece holds more than one arm (about 0.61 x 2.02 with the cell boxes).
-  LabelGrid g;
-  g.x = g.y = GridAxis{0.0, 0.02, 101};
-  g.labels.resize(101 * 101);
-  for (int j = 0; j < 101; ++j)
-    for (int i = 0; i < 101; ++i) {
-      const Eigen::Vector2d x = g.node(i, j);
-      g.labels[j * 101 + i] = (x.x() <= 0.6 || x.y() <= 0.6) ? kCellPreferable : kCellReachable;
-    }
-  const PolygonFitResult r = fitConservativePolygon(fitCellsFromGrid(g), PolygonFitOptions{});
-  ASSERT_TRUE(r.ok);
-  EXPECT_GT(r.area, 1.2);
-  EXPECT_LT(r.area, 1.3);
-  EXPECT_EQ(assessPolygon(g, r.polygon).bad_inside, 0);
-  EXPECT_EQ(badBoxesTouched(g, r.polygon), 0);
+  const LabelGrid g = shapeGrid(0.0, 101, [](const Eigen::Vector2d& x) { return x.x() <= 0.6 || x.y() <= 0.6; });
+  expectConservativeFit(g, 1.2, 1.3);
 }
 
 TEST(MftFit, SameSeedSameResult) {

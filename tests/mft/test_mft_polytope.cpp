@@ -8,12 +8,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <regex>
 #include <sstream>
 
 #include "model/config/strict_yaml.hpp"
 #include "model/mft_polytope.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using mft::config::ConfigError;
 using namespace mft::model;
@@ -21,12 +21,7 @@ using namespace mft::model;
 namespace {
 std::string robotPath() { return std::string(MFT_CONFIG_DIR) + "/robot.yaml"; }
 std::string polytopePath() { return std::string(MFT_CONFIG_DIR) + "/mft_space.yaml"; }
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using mft::test::readTextFile;
 std::string fmt(double v) {
   char b[40];
   std::snprintf(b, sizeof b, "%.17g", v);
@@ -34,17 +29,10 @@ std::string fmt(double v) {
 }
 void expectError(const std::string& pattern, const std::string& replacement, const std::string& expect) {
   const RobotDescription robot = loadRobotDescription(robotPath());
-  const std::string text = readText(polytopePath());
-  const std::string bad = std::regex_replace(text, std::regex(pattern), replacement, std::regex_constants::format_first_only);
-  ASSERT_NE(bad, text) << "pattern did not match: " << pattern;
-  try {
-    parseMftPolytope(bad, "bad-space.yaml", robot);
-    FAIL() << "expected a ConfigError containing '" << expect << "'";
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("bad-space.yaml"), std::string::npos) << msg;
-    EXPECT_NE(msg.find(expect), std::string::npos) << msg;
-  }
+  mft::test::expectConfigError(readTextFile(polytopePath()), pattern, replacement, "bad-space.yaml", expect,
+                               [&](const std::string& text, const std::string& origin) {
+                                 return parseMftPolytope(text, origin, robot);
+                               });
 }
 }  // namespace
 
@@ -88,7 +76,7 @@ TEST(MftPolytope, CommittedFileIsReproducedByARefit) {
 }
 
 TEST(MftPolytope, RefusesAPolytopeOfAnotherRobot) {
-  std::string text = readText(robotPath());
+  std::string text = readTextFile(robotPath());
   text = std::regex_replace(text, std::regex("mass_kg: 1.15"), "mass_kg: 1.25");
   const RobotDescription other = parseRobotDescription(text, "heavier-robot.yaml");
   try {

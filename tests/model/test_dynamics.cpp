@@ -434,34 +434,46 @@ TEST(DynamicsInertia, MdotMinusTwoCIsSkewSymmetric) {
 // ---------------------------------------------------------------------------------------------------------
 
 namespace {
-void randomLoads(std::mt19937& rng, VectorA* tau, VectorC* f_c) {
-  for (int i = 0; i < kNa; ++i) (*tau)(i) = uniform(rng, -40.0, 40.0);
-  *f_c << uniform(rng, -80.0, 80.0), uniform(rng, 0.0, 250.0), uniform(rng, -80.0, 80.0), uniform(rng, 0.0, 250.0);
+// A random closed-loop state with random joint torques and contact forces.
+struct LoadedState {
+  VectorQ q, qd;
+  VectorA tau;
+  VectorC f_c;
+};
+
+// Calls check(k, state, model data) for `per_robot` random loaded states of every robot description.
+template <class Check>
+void forRandomLoadedStates(std::mt19937& rng, int per_robot, Check&& check) {
+  for (const RobotDescription& d : descriptions()) {
+    const PlanarModel model = buildBipedModel(d);
+    for (int k = 0; k < per_robot; ++k) {
+      LoadedState s;
+      randomClosedState(rng, d, model, &s.q, &s.qd);
+      for (int i = 0; i < kNa; ++i) s.tau(i) = uniform(rng, -40.0, 40.0);
+      s.f_c << uniform(rng, -80.0, 80.0), uniform(rng, 0.0, 250.0), uniform(rng, -80.0, 80.0), uniform(rng, 0.0, 250.0);
+      check(k, s, updated(model, s.q, s.qd));
+    }
+  }
 }
 }  // namespace
 
 TEST(DynamicsConstrained, ForwardDynamicsKeepsTheLoopsClosed) {
   std::mt19937 rng(11);
-  for (const RobotDescription& d : descriptions()) {
-    const PlanarModel model = buildBipedModel(d);
-    for (int k = 0; k < 200; ++k) {
-      VectorQ q, qd, qdd;
-      randomClosedState(rng, d, model, &q, &qd);
-      VectorA tau;
-      VectorC f_c;
-      randomLoads(rng, &tau, &f_c);
-      const ModelData data = updated(model, q, qd);
-      VectorH f_h;
-      constrainedForwardDynamics(data, tau, f_c, &qdd, &f_h);
-      EXPECT_LT((data.Jh * qdd + data.Jh_dot_qd).cwiseAbs().maxCoeff(), 1e-10);
-      // The first block row of eq. 1 holds too.
-      const VectorQ residual = data.M * qdd - data.Jh.transpose() * f_h -
-                               (actuationSelector().transpose() * tau + data.Jc.transpose() * f_c - data.h);
-      EXPECT_LT(residual.cwiseAbs().maxCoeff(), 1e-9);
-      // Closure forces do no work on closure-consistent motion.
-      EXPECT_LT(std::abs(qd.dot(data.Jh.transpose() * f_h)), 1e-9 * (1.0 + f_h.norm()));
-    }
-  }
+  forRandomLoadedStates(rng, 200, [](int, const LoadedState& s, const ModelData& data) {
+    const VectorQ& qd = s.qd;
+    const VectorA& tau = s.tau;
+    const VectorC& f_c = s.f_c;
+    VectorQ qdd;
+    VectorH f_h;
+    constrainedForwardDynamics(data, tau, f_c, &qdd, &f_h);
+    EXPECT_LT((data.Jh * qdd + data.Jh_dot_qd).cwiseAbs().maxCoeff(), 1e-10);
+    // The first block row of eq. 1 holds too.
+    const VectorQ residual = data.M * qdd - data.Jh.transpose() * f_h -
+                             (actuationSelector().transpose() * tau + data.Jc.transpose() * f_c - data.h);
+    EXPECT_LT(residual.cwiseAbs().maxCoeff(), 1e-9);
+    // Closure forces do no work on closure-consistent motion.
+    EXPECT_LT(std::abs(qd.dot(data.Jh.transpose() * f_h)), 1e-9 * (1.0 + f_h.norm()));
+  });
 }
 
 TEST(DynamicsConstrained, ClosureProjectionProperties) {
@@ -487,30 +499,25 @@ TEST(DynamicsConstrained, InverseDynamicsRecoversTheTorquesOfForwardDynamics) {
   // must give tau back; eq. 2 and eq. 3 must hold on it as well.
   std::mt19937 rng(13);
   const MatrixAQ Sa = actuationSelector();
-  for (const RobotDescription& d : descriptions()) {
-    const PlanarModel model = buildBipedModel(d);
-    for (int k = 0; k < 200; ++k) {
-      VectorQ q, qd, qdd;
-      randomClosedState(rng, d, model, &q, &qd);
-      VectorA tau;
-      VectorC f_c;
-      randomLoads(rng, &tau, &f_c);
-      if (k % 4 == 0) f_c.setZero();  // flight phase
-      const ModelData data = updated(model, q, qd);
-      constrainedForwardDynamics(data, tau, f_c, &qdd, nullptr);
-      ClosureProjection proj;
-      closureProjection(data, &proj);
-      const VectorA tau_back = inverseDynamicsActuated(data, proj, qdd, qd, f_c);
-      EXPECT_LT((tau_back - tau).cwiseAbs().maxCoeff(), 1e-7) << "tau " << tau.transpose() << "\nback " << tau_back.transpose();
+  forRandomLoadedStates(rng, 200, [&Sa](int k, LoadedState& s, const ModelData& data) {
+    const VectorQ& qd = s.qd;
+    const VectorA& tau = s.tau;
+    VectorC& f_c = s.f_c;
+    if (k % 4 == 0) f_c.setZero();  // flight phase
+    VectorQ qdd;
+    constrainedForwardDynamics(data, tau, f_c, &qdd, nullptr);
+    ClosureProjection proj;
+    closureProjection(data, &proj);
+    const VectorA tau_back = inverseDynamicsActuated(data, proj, qdd, qd, f_c);
+    EXPECT_LT((tau_back - tau).cwiseAbs().maxCoeff(), 1e-7) << "tau " << tau.transpose() << "\nback " << tau_back.transpose();
 
-      const MatrixQ NhT = proj.N_h.transpose();
-      const VectorQ eq2 = data.M * qdd + NhT * data.h + data.Jh.transpose() * proj.Lambda_h * data.Jh_dot_qd -
-                          NhT * Sa.transpose() * tau - NhT * data.Jc.transpose() * f_c;
-      EXPECT_LT(eq2.cwiseAbs().maxCoeff(), 1e-8);
-      const Eigen::Vector3d eq3 = (data.M * qdd + NhT * data.h - NhT * data.Jc.transpose() * f_c).head<3>();
-      EXPECT_LT(eq3.cwiseAbs().maxCoeff(), 1e-8);
-    }
-  }
+    const MatrixQ NhT = proj.N_h.transpose();
+    const VectorQ eq2 = data.M * qdd + NhT * data.h + data.Jh.transpose() * proj.Lambda_h * data.Jh_dot_qd -
+                        NhT * Sa.transpose() * tau - NhT * data.Jc.transpose() * f_c;
+    EXPECT_LT(eq2.cwiseAbs().maxCoeff(), 1e-8);
+    const Eigen::Vector3d eq3 = (data.M * qdd + NhT * data.h - NhT * data.Jc.transpose() * f_c).head<3>();
+    EXPECT_LT(eq3.cwiseAbs().maxCoeff(), 1e-8);
+  });
 }
 
 TEST(DynamicsConstrained, PassiveClosedLoopMotionConservesEnergy) {

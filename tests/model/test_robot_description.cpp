@@ -3,13 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <vector>
 
 #include "model/config/strict_yaml.hpp"
 #include "model/robot_description.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using mft::config::ConfigError;
 using mft::model::loadRobotDescription;
@@ -17,25 +16,10 @@ using mft::model::parseRobotDescription;
 
 namespace {
 std::string defaultPath() { return std::string(MFT_CONFIG_DIR) + "/robot.yaml"; }
-std::string defaultText() {
-  std::ifstream in(defaultPath());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string defaultText() { return mft::test::readTextFile(defaultPath()); }
 // Replaces the first match of `pattern` in the default file and expects a ConfigError mentioning `expect`.
 void expectError(const std::string& pattern, const std::string& replacement, const std::string& expect) {
-  const std::string text = std::regex_replace(defaultText(), std::regex(pattern), replacement,
-                                              std::regex_constants::format_first_only);
-  ASSERT_NE(text, defaultText()) << "pattern did not match: " << pattern;
-  try {
-    parseRobotDescription(text, "bad-robot.yaml");
-    FAIL() << "expected a ConfigError containing '" << expect << "'";
-  } catch (const ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("bad-robot.yaml"), std::string::npos) << msg;
-    EXPECT_NE(msg.find(expect), std::string::npos) << msg;
-  }
+  mft::test::expectConfigError(defaultText(), pattern, replacement, "bad-robot.yaml", expect, parseRobotDescription);
 }
 }  // namespace
 

@@ -1,34 +1,17 @@
 // config/planner.yaml: the shipped file loads with the paper's values; bad files fail naming file and key.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <regex>
-#include <sstream>
-
 #include "model/config/strict_yaml.hpp"
 #include "planner/planner_config.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using namespace mft::planner;
 
 namespace {
 std::string path() { return std::string(MFT_CONFIG_DIR) + "/planner.yaml"; }
-std::string text() {
-  std::ifstream in(path());
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 void expectError(const std::string& pattern, const std::string& replacement, const std::string& expect) {
-  const std::string bad = std::regex_replace(text(), std::regex(pattern), replacement, std::regex_constants::format_first_only);
-  ASSERT_NE(bad, text()) << "pattern did not match: " << pattern;
-  try {
-    parsePlannerConfig(bad, "bad-planner.yaml");
-    FAIL() << "expected an error containing " << expect;
-  } catch (const mft::config::ConfigError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find("bad-planner.yaml"), std::string::npos) << msg;
-    EXPECT_NE(msg.find(expect), std::string::npos) << msg;
-  }
+  mft::test::expectConfigError(mft::test::readTextFile(path()), pattern, replacement, "bad-planner.yaml", expect,
+                               parsePlannerConfig);
 }
 }  // namespace
 

@@ -2,23 +2,16 @@
 // gait timing is refused as structure, and every tunable planner key exists in the file.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "model/config/live_tuning.hpp"
 #include "model/config/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 #include "planner/planner_tuning.hpp"
 
 using namespace mft;
 using namespace mft::planner;
 
 namespace {
-std::string projectText() {
-  std::ifstream in(std::string(MFT_CONFIG_DIR) + "/planner.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string projectText() { return mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/planner.yaml"); }
 std::string refusal(const std::string& key, const std::string& value) {
   try {
     applyPlannerOverride(projectText(), "planner.yaml (live change)", key, value);

@@ -72,6 +72,13 @@ const char* kSmall =
     "WBCQP 1\nname small\ndims 2 1 1\nH 2 2\n2 0\n0 1\ng 2\n1 -1\nAeq 1 2\n1 1\nbeq 1\n0.5\nAin 1 2\n1 -1\n"
     "lbA 1\n-inf\nubA 1\n3\nlb 2\n-inf 0\nub 2\ninf inf\nend\n";
 
+// kSmall with the first `from` replaced by `to`.
+std::string smallWith(const std::string& from, const std::string& to) {
+  std::string s = kSmall;
+  s.replace(s.find(from), from.size(), to);
+  return s;
+}
+
 }  // namespace
 
 TEST(QpIo, ReadsAnInstanceOfTheSet) {
@@ -126,27 +133,22 @@ TEST(QpIo, RoundTripThroughAFileIsBitExact) {
 
 TEST(QpIo, RefusesMalformedFilesNamingThem) {
   const std::string ok = kSmall;
-  auto replace = [&](const std::string& from, const std::string& to) {
-    std::string s = ok;
-    s.replace(s.find(from), from.size(), to);
-    return s;
-  };
   EXPECT_NO_THROW(parseQpInstance(ok, "ok"));
-  const std::string msg = refusal(replace("ub 2", "wibble 3\nub 2"));
+  const std::string msg = refusal(smallWith("ub 2", "wibble 3\nub 2"));
   EXPECT_NE(msg.find("bad_file.txt"), std::string::npos) << msg;
   EXPECT_NE(msg.find("unknown record 'wibble'"), std::string::npos) << msg;
-  EXPECT_NE(refusal(replace("g 2\n1 -1", "g 3\n1 -1 2")).find("length 3"), std::string::npos);
-  EXPECT_NE(refusal(replace("H 2 2\n2 0\n0 1", "H 2 1\n2\n0")).find("cols"), std::string::npos);
-  EXPECT_NE(refusal(replace("end\n", "")).find("end"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("g 2\n1 -1", "g 3\n1 -1 2")).find("length 3"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("H 2 2\n2 0\n0 1", "H 2 1\n2\n0")).find("cols"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("end\n", "")).find("end"), std::string::npos);
   EXPECT_NE(refusal(ok + "extra\n").find("after 'end'"), std::string::npos);
-  EXPECT_NE(refusal(replace("0.5", "0.5x")).find("0.5x"), std::string::npos);
-  EXPECT_NE(refusal(replace("0.5", "nan")).find("nan"), std::string::npos);
-  EXPECT_NE(refusal(replace("beq 1\n0.5\n", "")).find("missing record 'beq'"), std::string::npos);
-  EXPECT_NE(refusal(replace("WBCQP 1", "WBCQP 2")).find("version"), std::string::npos);
-  EXPECT_NE(refusal(replace("WBCQP 1", "QP 1")).find("WBCQP"), std::string::npos);
-  EXPECT_NE(refusal(replace("g 2\n1 -1\n", "g 2\n1 -1\ng 2\n1 -1\n")).find("duplicate"), std::string::npos);
-  EXPECT_FALSE(refusal(replace("ub 2\ninf inf\nend\n", "ub 2\ninf")).empty());  // truncated
-  EXPECT_FALSE(refusal(replace("dims 2 1 1\n", "")).empty());
+  EXPECT_NE(refusal(smallWith("0.5", "0.5x")).find("0.5x"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("0.5", "nan")).find("nan"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("beq 1\n0.5\n", "")).find("missing record 'beq'"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("WBCQP 1", "WBCQP 2")).find("version"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("WBCQP 1", "QP 1")).find("WBCQP"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("g 2\n1 -1\n", "g 2\n1 -1\ng 2\n1 -1\n")).find("duplicate"), std::string::npos);
+  EXPECT_FALSE(refusal(smallWith("ub 2\ninf inf\nend\n", "ub 2\ninf")).empty());  // truncated
+  EXPECT_FALSE(refusal(smallWith("dims 2 1 1\n", "")).empty());
   try {
     readQpInstance("/nonexistent/dir/missing.txt");
     ADD_FAILURE();
@@ -159,21 +161,15 @@ TEST(QpIo, RefusesMalformedFilesNamingThem) {
 // Issue 16, item 8: data a solver cannot treat as a convex QP is refused on reading, and dims are bounded by
 // what the file can hold before anything is allocated for them.
 TEST(QpIo, RefusesAsymmetricOrNonFiniteDataAndImpossibleDims) {
-  const std::string ok = kSmall;
-  auto replace = [&](const std::string& from, const std::string& to) {
-    std::string s = ok;
-    s.replace(s.find(from), from.size(), to);
-    return s;
-  };
-  const std::string asym = refusal(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 5\n0 1"));
+  const std::string asym = refusal(smallWith("H 2 2\n2 0\n0 1", "H 2 2\n2 5\n0 1"));
   EXPECT_NE(asym.find("H is not symmetric: H(1,0) = 0 but H(0,1) = 5"), std::string::npos) << asym;
   // Within the relative tolerance (1e-9 x max|H|) is symmetric: rounding of a dumped H must pass.
-  EXPECT_NO_THROW(parseQpInstance(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 1e-12\n0 1"), "ok"));
-  EXPECT_NE(refusal(replace("g 2\n1 -1", "g 2\ninf -1")).find("g has a non-finite entry"), std::string::npos);
-  EXPECT_NE(refusal(replace("H 2 2\n2 0\n0 1", "H 2 2\n2 0\n0 -inf")).find("H has a non-finite entry"), std::string::npos);
-  EXPECT_NE(refusal(replace("Aeq 1 2\n1 1", "Aeq 1 2\n1 inf")).find("Aeq has a non-finite entry"), std::string::npos);
+  EXPECT_NO_THROW(parseQpInstance(smallWith("H 2 2\n2 0\n0 1", "H 2 2\n2 1e-12\n0 1"), "ok"));
+  EXPECT_NE(refusal(smallWith("g 2\n1 -1", "g 2\ninf -1")).find("g has a non-finite entry"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("H 2 2\n2 0\n0 1", "H 2 2\n2 0\n0 -inf")).find("H has a non-finite entry"), std::string::npos);
+  EXPECT_NE(refusal(smallWith("Aeq 1 2\n1 1", "Aeq 1 2\n1 inf")).find("Aeq has a non-finite entry"), std::string::npos);
   const std::clock_t t0 = std::clock();  // CPU time: allocating 80 GB of H would take seconds, or fail
-  const std::string dims = refusal(replace("dims 2 1 1", "dims 100000 100000 100000"));
+  const std::string dims = refusal(smallWith("dims 2 1 1", "dims 100000 100000 100000"));
   EXPECT_LT(static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC, 0.1);
   EXPECT_NE(dims.find("need at least 30000000000 matrix entries, more than the file of"), std::string::npos) << dims;
 }

@@ -84,6 +84,24 @@ Metadata testMetadata() {
   return m;
 }
 
+// Options that record to `name` in `dir` with the test metadata.
+RecorderOptions testOptions(const TempDir& dir, const std::string& name) {
+  RecorderOptions opt;
+  opt.output = dir.file(name);
+  opt.metadata = testMetadata();
+  return opt;
+}
+
+// Records ticks 0 .. ticks-1 of tickMessages (random contents seeded with `seed`), every message once, in order.
+void recordTicks(const RecorderOptions& opt, std::uint64_t ticks, std::uint64_t seed) {
+  std::mt19937_64 g(seed);
+  Recorder rec(opt);
+  rec.start();
+  for (std::uint64_t k = 0; k < ticks; ++k)
+    for (const auto& m : tickMessages(k, g)) rec.push(m);
+  rec.stop();
+}
+
 std::vector<Message> readAll(RawlogReader& r) {
   MessageAssembler a(r.metadata().time_base_unix_ns);
   std::vector<Message> out;
@@ -117,9 +135,7 @@ TEST(RawlogFormat, TimestampsUseIntegerMath) {
 
 TEST(RawlogRecorder, WritesEveryTickInOrderBitExactAndDropsRepeats) {
   TempDir dir;
-  RecorderOptions opt;
-  opt.output = dir.file("run.rawlog");
-  opt.metadata = testMetadata();
+  RecorderOptions opt = testOptions(dir, "run.rawlog");
   std::mt19937_64 g(42);
   std::vector<Message> sent;
   {
@@ -166,9 +182,7 @@ TEST(RawlogRecorder, WritesEveryTickInOrderBitExactAndDropsRepeats) {
 
 TEST(RawlogRecorder, CountsGapsAndSplitsIntoSelfContainedPieces) {
   TempDir dir;
-  RecorderOptions opt;
-  opt.output = dir.file("split.rawlog");
-  opt.metadata = testMetadata();
+  RecorderOptions opt = testOptions(dir, "split.rawlog");
   opt.split_s = 0.1;
   std::mt19937_64 g(7);
   Recorder rec(opt);
@@ -193,17 +207,8 @@ TEST(RawlogRecorder, CountsGapsAndSplitsIntoSelfContainedPieces) {
 
 TEST(RawlogReader, TruncatedFileReadsUpToTheLastWholeRecord) {
   TempDir dir;
-  RecorderOptions opt;
-  opt.output = dir.file("t.rawlog");
-  opt.metadata = testMetadata();
-  std::mt19937_64 g(3);
-  {
-    Recorder rec(opt);
-    rec.start();
-    for (std::uint64_t k = 0; k < 2000; ++k)
-      for (const auto& m : tickMessages(k, g)) rec.push(m);
-    rec.stop();
-  }
+  RecorderOptions opt = testOptions(dir, "t.rawlog");
+  recordTicks(opt, 2000, 3);
   const auto size = fs::file_size(opt.output);
   std::ifstream in(opt.output, std::ios::binary);
   std::string bytes(size * 6 / 10, '\0');
@@ -242,18 +247,9 @@ std::size_t inflatableBytes(const std::string& path) {
 // zlib's buffer: about 0.1 s of a real recording was lost behind the last flush.)
 TEST(RawlogReader, CutFileGivesBackEveryTickBeforeTheCut) {
   TempDir dir;
-  RecorderOptions opt;
-  opt.output = dir.file("t.rawlog");
-  opt.metadata = testMetadata();
+  RecorderOptions opt = testOptions(dir, "t.rawlog");
   constexpr std::uint64_t kTicks = 3000;
-  std::mt19937_64 g(5);
-  {
-    Recorder rec(opt);
-    rec.start();
-    for (std::uint64_t k = 0; k < kTicks; ++k)
-      for (const auto& m : tickMessages(k, g)) rec.push(m);
-    rec.stop();
-  }
+  recordTicks(opt, kTicks, 5);
   const std::size_t full_raw = inflatableBytes(opt.output);
   std::ifstream in(opt.output, std::ios::binary);
   std::string bytes(fs::file_size(opt.output) * 7 / 10, '\0');
@@ -356,17 +352,8 @@ namespace {
 
 // A small real recording, decompressed: the base for crafted files.
 std::string recordedBytes(const TempDir& dir) {
-  RecorderOptions opt;
-  opt.output = dir.file("base.rawlog");
-  opt.metadata = testMetadata();
-  std::mt19937_64 g(7);
-  {
-    Recorder rec(opt);
-    rec.start();
-    for (std::uint64_t k = 0; k < 20; ++k)
-      for (const auto& m : tickMessages(k, g)) rec.push(m);
-    rec.stop();
-  }
+  RecorderOptions opt = testOptions(dir, "base.rawlog");
+  recordTicks(opt, 20, 7);
   std::string raw;
   gzFile f = gzopen(opt.output.c_str(), "rb");
   char buf[65536];
@@ -598,9 +585,7 @@ TEST(RawlogBadInput, ExportAndReplayRefuseAHugeDeclaredObjectInWellUnderASecond)
 // contents, so the torques themselves differ: the tolerance is set out of the way), none is "unmatched".
 TEST(RawlogReplay, ThroughWbcPairsInputsAndCommandsByTickWhateverTheRecordedOrder) {
   TempDir dir;
-  RecorderOptions opt;
-  opt.output = dir.file("reordered.rawlog");
-  opt.metadata = testMetadata();
+  RecorderOptions opt = testOptions(dir, "reordered.rawlog");
   for (const char* name : {"robot.yaml", "wbc.yaml", "mft_space.yaml"}) {
     std::ifstream in(std::string(MFT_CONFIG_DIR) + "/" + name);
     std::stringstream text;

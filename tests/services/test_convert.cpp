@@ -6,6 +6,18 @@
 
 using namespace mft;
 
+namespace {
+// `value` converted to the DDS message `Msg` and back.
+template <class Msg, class T>
+T roundTrip(const T& value) {
+  Msg m;
+  services::toMsg(value, &m);
+  T back;
+  services::fromMsg(m, &back);
+  return back;
+}
+}  // namespace
+
 TEST(Convert, SensorReadingsRoundTrip) {
   model::SensorReadings s;
   s.tick = 77;
@@ -20,10 +32,7 @@ TEST(Convert, SensorReadingsRoundTrip) {
   s.gyro_pitch_rate = 0.3;
   s.accel = {0.5, 9.7};
   s.contact = {true, false};
-  msg::SensorData m;
-  services::toMsg(s, &m);
-  model::SensorReadings back;
-  services::fromMsg(m, &back);
+  const model::SensorReadings back = roundTrip<msg::SensorData>(s);
   EXPECT_EQ(back.tick, 77u);
   EXPECT_NEAR(back.time_s, 0.077, 1e-12);
   EXPECT_EQ(back.actuated_pos, s.actuated_pos);
@@ -42,10 +51,7 @@ TEST(Convert, StateTruthAndCommandRoundTrip) {
   st.q = model::VectorQ::LinSpaced(-1, 1);
   st.qd = model::VectorQ::LinSpaced(2, 3);
   st.contact = {false, true};
-  msg::RobotState ms;
-  services::toMsg(st, &ms);
-  model::RobotStateEstimate st2;
-  services::fromMsg(ms, &st2);
+  const model::RobotStateEstimate st2 = roundTrip<msg::RobotState>(st);
   EXPECT_EQ(st2.q, st.q);
   EXPECT_EQ(st2.qd, st.qd);
   EXPECT_EQ(st2.contact, st.contact);
@@ -54,10 +60,7 @@ TEST(Convert, StateTruthAndCommandRoundTrip) {
   gt.q = model::VectorQ::Constant(0.25);
   gt.contact_force << 1, 2, 3, 4;
   gt.lti = {0.8, 0.6};
-  msg::GroundTruth mg;
-  services::toMsg(gt, &mg);
-  model::GroundTruthState gt2;
-  services::fromMsg(mg, &gt2);
+  const model::GroundTruthState gt2 = roundTrip<msg::GroundTruth>(gt);
   EXPECT_EQ(gt2.q, gt.q);
   EXPECT_EQ(gt2.contact_force, gt.contact_force);
   EXPECT_EQ(gt2.lti, gt.lti);
@@ -115,4 +118,55 @@ TEST(Convert, PlanToWbcReference) {
   services::toMsg(p, &m);
   services::fromMsg(m, &r);
   EXPECT_FALSE(r.hold_base_x);
+}
+
+TEST(Convert, OperatorCommandModeOctets) {
+  msg::OperatorCommand m;
+  m.z_cmd(0.41);
+  m.v_cmd(0.25);
+  planner::OperatorCommand c;
+  const std::pair<std::uint8_t, planner::LocomotionMode> octets[] = {
+      {msg::LOCOMOTION_STAND, planner::LocomotionMode::Stand},
+      {msg::LOCOMOTION_STEP_IN_PLACE, planner::LocomotionMode::StepInPlace},
+      {msg::LOCOMOTION_WALK, planner::LocomotionMode::Walk},
+      {static_cast<std::uint8_t>(msg::LOCOMOTION_WALK + 1), planner::LocomotionMode::Stand}};  // refused upstream
+  for (const auto& [octet, mode] : octets) {
+    m.mode(octet);
+    services::fromMsg(m, &c);
+    EXPECT_EQ(c.mode, mode) << "octet " << int(octet);
+    EXPECT_EQ(c.z_cmd, 0.41);
+    EXPECT_EQ(c.v_cmd, 0.25);
+  }
+}
+
+TEST(Convert, WbcDiagnosticsToMsg) {
+  wbc::WbcDiagnostics d;
+  d.tick = 42;
+  d.solve_time_us = 3.5;
+  d.tick_time_us = 12.25;
+  d.iterations = 7;
+  d.status = qp::QpStatus::Optimal;
+  d.active_constraints = 4;
+  d.slack_norm = 1e-3;
+  d.task_error = {1, 2, 3, 4, 5, 6};
+  d.lti = {0.7, 0.8};
+  d.raci = {2.5, 3.5};
+  d.safety.events = 2;
+  d.safety_mode = wbc::SafetyMode::Damping;
+  msg::WbcDiagnostics m;
+  services::toMsg(d, 42000000, &m);
+  EXPECT_EQ(m.tick(), 42u);
+  EXPECT_EQ(m.stamp_ns(), 42000000u);
+  EXPECT_EQ(m.solve_time_us(), 3.5);
+  EXPECT_EQ(m.tick_time_us(), 12.25);
+  EXPECT_EQ(m.iterations(), 7);
+  EXPECT_EQ(m.status(), static_cast<std::int32_t>(qp::QpStatus::Optimal));
+  EXPECT_EQ(m.active_constraints(), 4);
+  EXPECT_EQ(m.slack_norm(), 1e-3);
+  EXPECT_EQ(m.task_error()[5], 6.0);
+  EXPECT_EQ(m.lti()[1], 0.8);
+  EXPECT_EQ(m.raci()[0], 2.5);
+  EXPECT_EQ(m.safety_events(), 2u);
+  EXPECT_FALSE(m.holding());
+  EXPECT_TRUE(m.damping());
 }

@@ -2,35 +2,19 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <regex>
-#include <sstream>
 
 #include "model/config/strict_yaml.hpp"
 #include "chain/scenario.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using mft::config::ConfigError;
 using namespace mft::chain;
 
 namespace {
 std::string scenarioDir() { return std::string(MFT_CONFIG_DIR) + "/scenarios"; }
-std::string stepText() {
-  std::ifstream in(scenarioDir() + "/step-in-place.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string stepText() { return mft::test::readTextFile(scenarioDir() + "/step-in-place.yaml"); }
 void expectError(const std::string& pattern, const std::string& replacement, const std::string& expect) {
-  const std::string text = std::regex_replace(stepText(), std::regex(pattern), replacement,
-                                              std::regex_constants::format_first_only);
-  ASSERT_NE(text, stepText()) << pattern;
-  try {
-    parseScenario(text, "bad.yaml");
-    FAIL() << "expected an error containing " << expect;
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
-    EXPECT_NE(std::string(e.what()).find("bad.yaml"), std::string::npos) << e.what();
-  }
+  mft::test::expectConfigError(stepText(), pattern, replacement, "bad.yaml", expect, parseScenario);
 }
 }  // namespace
 

@@ -17,6 +17,20 @@ inline Terrain terrainFile(const std::string& name) {
   return loadTerrain(std::string(MFT_CONFIG_DIR) + "/terrain/" + name);
 }
 
+// For the actuator tests (options with fix_torso): resets `sim` with the torso held in the air at base_height_m
+// and 0.40 m legs, and drives the right leg's rear and fore hips with constant torques. Returns that command.
+inline model::ActuatorCommand hangAndDriveRightHips(Simulator& sim, double base_height_m, double tau_rear,
+                                                    double tau_fore) {
+  StandingPose pose;
+  pose.base_height_m = base_height_m;
+  pose.leg_length_m = 0.40;
+  sim.reset(pose);
+  model::ActuatorCommand c;
+  c.tau << tau_rear, tau_fore, 0.0, 0.0;
+  sim.setCommand(c);
+  return c;
+}
+
 // Joint-space PD on the four hips around a fixed target, plus the torque that carries half the weight on
 // each foot. Kp >= 300 N m/rad is needed for this geometry (docs/simulation.md#standing-with-a-joint-pd).
 struct StanceController {

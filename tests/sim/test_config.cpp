@@ -2,23 +2,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <utility>
 
 #include "model/config/strict_yaml.hpp"
 #include "sim_test_support.hpp"
+#include "tests/support/config_test_support.hpp"
 
 using namespace mft::sim;
 using mft::config::ConfigError;
 
 namespace {
-std::string readFile(const std::string& path) {
-  std::ifstream f(path);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
 std::string errorOf(const std::function<void()>& f) {
   try {
     f();
@@ -38,7 +31,7 @@ TEST(SimConfig, LoadsShippedOptions) {
 }
 
 TEST(SimConfig, RejectsUnknownAndMissingKeys) {
-  const std::string text = readFile(std::string(MFT_CONFIG_DIR) + "/sim.yaml");
+  const std::string text = mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/sim.yaml");
   const std::string unknown = text + "\nsurprise: 1\n";
   EXPECT_NE(errorOf([&] { parseSimOptions(unknown, "x.yaml"); }).find("surprise"), std::string::npos);
   std::string missing = text;
@@ -50,7 +43,7 @@ TEST(SimConfig, RejectsUnknownAndMissingKeys) {
 }
 
 TEST(SimConfig, ActuatorModels) {
-  const std::string text = readFile(std::string(MFT_CONFIG_DIR) + "/sim.yaml");
+  const std::string text = mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/sim.yaml");
   const std::string line = "  model: " + std::string(test::options().actuator_model == ActuatorModel::SeaMotor ? "sea_motor" : "sea");
   for (const auto& [name, model] : {std::pair<std::string, ActuatorModel>{"sea", ActuatorModel::Sea},
                                     {"sea_motor", ActuatorModel::SeaMotor}, {"ideal", ActuatorModel::Ideal}}) {

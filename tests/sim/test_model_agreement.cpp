@@ -72,6 +72,32 @@ VectorA randomTorque(SplitMix64& rng) {
   return t;
 }
 
+void commandTorques(Simulator& sim, const VectorA& tau) {
+  mft::model::ActuatorCommand c;
+  c.tau = tau;
+  sim.setCommand(c);
+}
+
+// Draws a random state (randomState) and random torques, puts the simulator in that state and commands those
+// torques. Returns false when the draw is rejected (the simulator is left as it was).
+bool startFromRandomState(Simulator& sim, const mft::model::RobotDescription& d, SplitMix64& rng, bool moving,
+                          VectorQ* q, VectorQ* qd, VectorA* tau) {
+  if (!randomState(d, rng, moving, q, qd)) return false;
+  *tau = randomTorque(rng);
+  sim.setState(*q, *qd, *tau);
+  commandTorques(sim, *tau);
+  return true;
+}
+
+// Expects ODE's acceleration within 1e-3 of the model's (relative to its largest entry, at least 1); returns the
+// largest difference.
+double expectAccelerationsAgree(const VectorQ& qdd_ode, const VectorQ& qdd_model) {
+  const double difference = (qdd_ode - qdd_model).cwiseAbs().maxCoeff();
+  EXPECT_LT(difference, 1e-3 * std::max(1.0, qdd_model.cwiseAbs().maxCoeff()))
+      << "ode   " << qdd_ode.transpose() << "\nmodel " << qdd_model.transpose();
+  return difference;
+}
+
 VectorQ modelQdd(const mft::model::PlanarModel& m, const VectorQ& q, const VectorQ& qd, const VectorA& tau,
                  const VectorC& fc) {
   mft::model::ModelData data;
@@ -82,11 +108,16 @@ VectorQ modelQdd(const mft::model::PlanarModel& m, const VectorQ& q, const Vecto
   return qdd;
 }
 
+// Every case compares the shipped robot in ODE with its model.
+class SimModelAgreement : public ::testing::Test {
+ protected:
+  const mft::model::RobotDescription d = test::robot();
+  const mft::model::PlanarModel model = mft::model::buildBipedModel(d);
+};
+
 }  // namespace
 
-TEST(SimModelAgreement, AccelerationsAtRestInTheAir) {
-  const auto d = test::robot();
-  const auto model = mft::model::buildBipedModel(d);
+TEST_F(SimModelAgreement, AccelerationsAtRestInTheAir) {
   const double h = 1e-4;
   Simulator sim(d, fineOptions(h), Terrain::flat());
   SplitMix64 rng(42);
@@ -94,28 +125,20 @@ TEST(SimModelAgreement, AccelerationsAtRestInTheAir) {
   int n = 0;
   while (n < 50) {
     VectorQ q, qd;
-    if (!randomState(d, rng, false, &q, &qd)) continue;
-    const VectorA tau = randomTorque(rng);
-    sim.setState(q, qd, tau);
-    mft::model::ActuatorCommand c;
-    c.tau = tau;
-    sim.setCommand(c);
+    VectorA tau;
+    if (!startFromRandomState(sim, d, rng, false, &q, &qd, &tau)) continue;
     sim.step();
     const VectorQ qdd_ode = (sim.groundTruth().qd - qd) / h;
     const VectorQ qdd_model = modelQdd(model, q, qd, tau, VectorC::Zero());
-    worst = std::max(worst, (qdd_ode - qdd_model).cwiseAbs().maxCoeff());
+    worst = std::max(worst, expectAccelerationsAgree(qdd_ode, qdd_model));
     scale = std::max(scale, qdd_model.cwiseAbs().maxCoeff());
-    EXPECT_LT((qdd_ode - qdd_model).cwiseAbs().maxCoeff(), 1e-3 * std::max(1.0, qdd_model.cwiseAbs().maxCoeff()))
-        << "ode   " << qdd_ode.transpose() << "\nmodel " << qdd_model.transpose();
     ++n;
   }
   std::cout << "at rest, in the air: max |qdd_ode - qdd_model| = " << worst << " (largest |qdd| " << scale << ")\n";
 }
 
-TEST(SimModelAgreement, AccelerationsStandingWithContactForces) {
+TEST_F(SimModelAgreement, AccelerationsStandingWithContactForces) {
   // On the ground: the contact forces ODE applied (measured) go into the model's eq. 1 as f_c.
-  const auto d = test::robot();
-  const auto model = mft::model::buildBipedModel(d);
   const double h = 1e-4;
   Simulator sim(d, fineOptions(h), Terrain::flat());
   SplitMix64 rng(7);
@@ -127,26 +150,19 @@ TEST(SimModelAgreement, AccelerationsStandingWithContactForces) {
     pose.foot_offset_x_m = {0.1 * rng.uniform() - 0.05, 0.1 * rng.uniform() - 0.05};
     sim.reset(pose);
     const VectorQ q = sim.groundTruth().q, qd = sim.groundTruth().qd;
-    const VectorA tau = sim.seaTorque() + 5.0 * randomTorque(rng) / 20.0;
-    mft::model::ActuatorCommand c;
-    c.tau = tau;
-    sim.setCommand(c);
+    commandTorques(sim, sim.seaTorque() + 5.0 * randomTorque(rng) / 20.0);
     sim.step();
     const VectorC fc = sim.groundTruth().contact_force;
     ASSERT_GT(fc[1], 10.0);
     ASSERT_GT(fc[3], 10.0);
     const VectorQ qdd_ode = (sim.groundTruth().qd - qd) / h;
     const VectorQ qdd_model = modelQdd(model, q, qd, sim.seaTorque(), fc);
-    worst = std::max(worst, (qdd_ode - qdd_model).cwiseAbs().maxCoeff());
-    EXPECT_LT((qdd_ode - qdd_model).cwiseAbs().maxCoeff(), 1e-3 * std::max(1.0, qdd_model.cwiseAbs().maxCoeff()))
-        << "ode   " << qdd_ode.transpose() << "\nmodel " << qdd_model.transpose();
+    worst = std::max(worst, expectAccelerationsAgree(qdd_ode, qdd_model));
   }
   std::cout << "standing, measured contact forces: max |qdd_ode - qdd_model| = " << worst << "\n";
 }
 
-TEST(SimModelAgreement, MeanAccelerationsWhileMoving) {
-  const auto d = test::robot();
-  const auto model = mft::model::buildBipedModel(d);
+TEST_F(SimModelAgreement, MeanAccelerationsWhileMoving) {
   const double h_ode = 1e-5, window = 0.01, h_rk = 1e-4;
   Simulator sim(d, fineOptions(h_ode), Terrain::flat());
   SplitMix64 rng(3);
@@ -154,12 +170,8 @@ TEST(SimModelAgreement, MeanAccelerationsWhileMoving) {
   int n = 0;
   while (n < 10) {
     VectorQ q, qd;
-    if (!randomState(d, rng, true, &q, &qd)) continue;
-    const VectorA tau = randomTorque(rng);
-    sim.setState(q, qd, tau);
-    mft::model::ActuatorCommand c;
-    c.tau = tau;
-    sim.setCommand(c);
+    VectorA tau;
+    if (!startFromRandomState(sim, d, rng, true, &q, &qd, &tau)) continue;
     const int steps = static_cast<int>(std::lround(window / h_ode));
     for (int k = 0; k < steps; ++k) sim.step();
     const VectorQ mean_ode = (sim.groundTruth().qd - qd) / window;

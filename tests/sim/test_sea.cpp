@@ -24,13 +24,7 @@ TEST(SimSea, SimulatorSensorSettlesInTs) {
   o.fix_torso = true;
   o.actuator_model = ActuatorModel::Sea;  // the filter model (sea_motor's free thigh: test_sea_motor.cpp)
   Simulator sim(test::robot(), o, Terrain::flat());
-  StandingPose pose;
-  pose.base_height_m = 1.0;
-  pose.leg_length_m = 0.40;
-  sim.reset(pose);
-  mft::model::ActuatorCommand c;
-  c.tau << 10.0, 0.0, 0.0, 0.0;
-  sim.setCommand(c);
+  test::hangAndDriveRightHips(sim, 1.0, 10.0, 0.0);
   double last_outside = 0.0;
   for (int k = 0; k < 40; ++k) {  // before the swinging leg nears the speed limit or a stop
     sim.step();
@@ -65,13 +59,7 @@ TEST(SimSea, SpeedLimitHoldsInSimulation) {
   o.link_collisions = false;
   o.actuator_model = ActuatorModel::Sea;  // the filter model's output limit (sea_motor: test_sea_motor.cpp)
   Simulator sim(test::robot(), o, Terrain::flat());
-  StandingPose pose;
-  pose.base_height_m = 2.0;
-  pose.leg_length_m = 0.40;
-  sim.reset(pose);
-  mft::model::ActuatorCommand c;
-  c.tau << 50.0, 50.0, 0.0, 0.0;  // both right hips forward: the whole leg spins up
-  sim.setCommand(c);
+  test::hangAndDriveRightHips(sim, 2.0, 50.0, 50.0);  // both right hips forward: the whole leg spins up
   const double limit = sim.robot().actuator.output_speed_limit_radps;
   double max_rate = 0.0;
   // Until the rear hip nears its stop (an impact on a stop makes the other thigh's rate jump).
@@ -95,13 +83,7 @@ TEST(SimSea, DampingModeOpposesMotion) {
   auto o = test::options();
   o.fix_torso = true;
   Simulator sim(test::robot(), o, Terrain::flat());
-  StandingPose pose;
-  pose.base_height_m = 1.0;
-  pose.leg_length_m = 0.40;
-  sim.reset(pose);
-  mft::model::ActuatorCommand c;
-  c.tau << 20.0, 20.0, 0.0, 0.0;
-  sim.setCommand(c);
+  mft::model::ActuatorCommand c = test::hangAndDriveRightHips(sim, 1.0, 20.0, 20.0);
   for (int k = 0; k < 40; ++k) sim.step();
   const double rate = sim.groundTruth().qd[mft::model::hipRearIndex(0)];
   ASSERT_GT(rate, 1.0);

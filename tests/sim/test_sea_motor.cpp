@@ -242,13 +242,7 @@ TEST(SimSeaMotor, SimulatorFreeThighPaysForTheRotor) {
   o.fix_torso = true;
   o.actuator_model = ActuatorModel::SeaMotor;
   Simulator sim(test::robot(), o, Terrain::flat());
-  mft::sim::StandingPose pose;
-  pose.base_height_m = 1.0;
-  pose.leg_length_m = 0.40;
-  sim.reset(pose);
-  mft::model::ActuatorCommand c;
-  c.tau << 10.0, 0.0, 0.0, 0.0;
-  sim.setCommand(c);
+  test::hangAndDriveRightHips(sim, 1.0, 10.0, 0.0);
   const SeaMotorActuator ref(shippedParams(), kH, shippedLimits());
   const double kp1 = 1.0 + ref.proportionalGain(), jr = shippedParams().reflected_inertia_kgm2;
   const double br = shippedParams().reflected_damping_Nmsprad;
@@ -277,13 +271,7 @@ TEST(SimSeaMotor, SpeedLimitInSimulation) {
   o.link_collisions = false;
   o.actuator_model = ActuatorModel::SeaMotor;
   Simulator sim(test::robot(), o, Terrain::flat());
-  mft::sim::StandingPose pose;
-  pose.base_height_m = 2.0;
-  pose.leg_length_m = 0.40;
-  sim.reset(pose);
-  mft::model::ActuatorCommand c;
-  c.tau << 50.0, 50.0, 0.0, 0.0;  // both right hips forward: the whole leg spins up
-  sim.setCommand(c);
+  test::hangAndDriveRightHips(sim, 2.0, 50.0, 50.0);  // both right hips forward: the whole leg spins up
   const double limit = sim.robot().actuator.output_speed_limit_radps;
   double max_motor = 0.0, max_rate = 0.0;
   for (int k = 0; k < 150 && sim.groundTruth().q[mft::model::hipRearIndex(0)] < 0.25; ++k) {  // before the stop

@@ -1,22 +1,15 @@
 // config/wbc.yaml: strict loading, Table I defaults, clear errors.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "model/config/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 #include "wbc/whole_body_controller.hpp"
 #include "wbc_test_support.hpp"
 
 namespace mft::wbc {
 namespace {
 
-std::string projectYaml() {
-  std::ifstream in(std::string(MFT_CONFIG_DIR) + "/wbc.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string projectYaml() { return mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/wbc.yaml"); }
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto pos = text.find(from);

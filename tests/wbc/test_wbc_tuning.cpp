@@ -4,11 +4,9 @@
 // file computes.
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <sstream>
-
 #include "model/config/live_tuning.hpp"
 #include "model/config/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 #include "wbc/whole_body_controller.hpp"
 #include "wbc/wbc_tuning.hpp"
 #include "wbc_test_support.hpp"
@@ -18,16 +16,11 @@ using namespace mft::wbc;
 
 namespace {
 
-std::string projectText() {
-  std::ifstream in(std::string(MFT_CONFIG_DIR) + "/wbc.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string projectText() { return mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/wbc.yaml"); }
 
 std::string refusal(const std::string& key, const std::string& value) {
   try {
-    applyWbcOverride(projectText(), "wbc.yaml (live change)", key, value, test::robot());
+    applyWbcOverride(projectText(), "wbc.yaml (live change)", key, value, wbc::test::robot());
   } catch (const config::ConfigError& e) {
     return e.what();
   }
@@ -37,8 +30,8 @@ std::string refusal(const std::string& key, const std::string& value) {
 }  // namespace
 
 TEST(WbcTuning, AChangeIsReadByTheStrictLoaderAndTouchesOnlyItsKey) {
-  const WbcConfig before = test::projectConfig(WbcVariant::Mft);
-  const WbcOverride o = applyWbcOverride(projectText(), "wbc.yaml (live change)", "weights.slack", "1e5", test::robot());
+  const WbcConfig before = wbc::test::projectConfig(WbcVariant::Mft);
+  const WbcOverride o = applyWbcOverride(projectText(), "wbc.yaml (live change)", "weights.slack", "1e5", wbc::test::robot());
   EXPECT_EQ(o.config.weights.slack, 1e5);
   EXPECT_EQ(o.value, std::vector<double>{1e5});
   EXPECT_EQ(o.previous, std::vector<double>{before.weights.slack});
@@ -46,7 +39,7 @@ TEST(WbcTuning, AChangeIsReadByTheStrictLoaderAndTouchesOnlyItsKey) {
   EXPECT_EQ(o.config.gains.base_z.kp, before.gains.base_z.kp);
   // A change on top of the previous one (the service judges each against the text in force).
   const WbcOverride o2 = applyWbcOverride(o.yaml_text, "wbc.yaml (live change)", "gains.swing_foot.kp", "[300, 250]",
-                                          test::robot());
+                                          wbc::test::robot());
   EXPECT_EQ(o2.config.weights.slack, 1e5);
   EXPECT_EQ(o2.config.gains.swing_foot.kp, Eigen::Vector2d(300, 250));
   EXPECT_EQ(o2.previous, (std::vector<double>{before.gains.swing_foot.kp[0], before.gains.swing_foot.kp[1]}));
@@ -78,19 +71,19 @@ TEST(WbcTuning, EveryTunableKeyExistsInTheFileAndIsAccepted) {
 }
 
 TEST(WbcTuning, SetTuningActsLikeAControllerBuiltWithTheChangedFile) {
-  const WbcPolytope poly = test::testPolytope();
-  test::StateSpec s;
+  const WbcPolytope poly = wbc::test::testPolytope();
+  wbc::test::StateSpec s;
   s.base_vel = {0.05, -0.1, 0.2};  // the PD terms see an error
-  const model::RobotStateEstimate st = test::makeState(s);
-  WbcReference ref = test::holdReference(st);
+  const model::RobotStateEstimate st = wbc::test::makeState(s);
+  WbcReference ref = wbc::test::holdReference(st);
   ref.base_z.pos += 0.01;
-  const WbcOverride o = applyWbcOverride(projectText(), "wbc.yaml (live change)", "gains.base_z.kp", "100", test::robot());
-  WbcOverride o2 = applyWbcOverride(o.yaml_text, "wbc.yaml (live change)", "weights.contact_force", "1e-2", test::robot());
+  const WbcOverride o = applyWbcOverride(projectText(), "wbc.yaml (live change)", "gains.base_z.kp", "100", wbc::test::robot());
+  WbcOverride o2 = applyWbcOverride(o.yaml_text, "wbc.yaml (live change)", "weights.contact_force", "1e-2", wbc::test::robot());
   o2.config.variant = WbcVariant::Mft;
 
-  WholeBodyController tuned(test::robot(), test::projectConfig(WbcVariant::Mft), poly);
-  WholeBodyController fresh(test::robot(), o2.config, poly);
-  WholeBodyController untouched(test::robot(), test::projectConfig(WbcVariant::Mft), poly);
+  WholeBodyController tuned(wbc::test::robot(), wbc::test::projectConfig(WbcVariant::Mft), poly);
+  WholeBodyController fresh(wbc::test::robot(), o2.config, poly);
+  WholeBodyController untouched(wbc::test::robot(), wbc::test::projectConfig(WbcVariant::Mft), poly);
   tuned.setTuning(tuningOf(o2.config));
   EXPECT_EQ(tuned.tuning().gains.base_z.kp, 100.0);
   EXPECT_EQ(tuned.tuning().weights.contact_force, 1e-2);

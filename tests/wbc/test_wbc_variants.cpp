@@ -103,6 +103,23 @@ model::VectorA predictedPassive(const model::RobotStateEstimate& st, const model
   return p;
 }
 
+// The left leg in swing with its foot at (-0.02, foot_z) moving down at `speed`, and a reference `reach` lower
+// that asks it to keep stretching at that speed.
+struct StretchingSwing {
+  model::RobotStateEstimate st;
+  WbcReference ref;
+};
+StretchingSwing stretchingLeftSwing(double foot_z, double speed, double reach) {
+  test::StateSpec s;
+  s.left_foot = {-0.02, foot_z};
+  s.left_foot_vel = {0.0, -speed};
+  StretchingSwing c{makeState(s), {}};
+  c.ref = test::holdReference(c.st, true, false);
+  c.ref.foot_pos[3] -= reach;
+  c.ref.foot_vel[3] = -speed;
+  return c;
+}
+
 TEST(WbcVariants, SaRespectsThePassiveJointBoundsOfEq14) {
   const WbcConfig sa_cfg = test::projectConfig(WbcVariant::Sa);
   const model::VectorA lo(sa_cfg.sa.rear_knee_rad.lo, sa_cfg.sa.fore_knee_rad.lo, sa_cfg.sa.rear_knee_rad.lo,
@@ -111,13 +128,9 @@ TEST(WbcVariants, SaRespectsThePassiveJointBoundsOfEq14) {
                           sa_cfg.sa.fore_knee_rad.hi);
   // Left leg in swing, nearly stretched and stretching further: coasting would straighten its knees past the
   // 0.1 rad boundary; its reference asks to keep stretching.
-  test::StateSpec s;
-  s.left_foot = {-0.02, -0.470};
-  s.left_foot_vel = {0.0, -0.28};
-  const model::RobotStateEstimate st = makeState(s);
-  WbcReference ref = test::holdReference(st, true, false);
-  ref.foot_pos[3] -= 0.02;
-  ref.foot_vel[3] = -0.28;
+  const StretchingSwing swing = stretchingLeftSwing(-0.470, 0.28, 0.02);
+  const model::RobotStateEstimate& st = swing.st;
+  const WbcReference& ref = swing.ref;
 
   WholeBodyController sa(robot(), sa_cfg, nullptr);
   WholeBodyController none(robot(), test::projectConfig(WbcVariant::None), nullptr);
@@ -149,13 +162,9 @@ TEST(WbcVariants, SaAsksForTheStrongestCorrectionWhenTheBoundIsOutOfReach) {
   // Coasting would end 0.05 rad past the boundary; the qdd box can correct only dt^2/2 * 22 = 0.0275 rad.
   // Eq. 14 taken literally would make the QP infeasible (and the safety stage damp); the row is clipped to
   // what the box can reach instead.
-  test::StateSpec s;
-  s.left_foot = {-0.02, -0.475};
-  s.left_foot_vel = {0.0, -0.15};
-  const model::RobotStateEstimate st = makeState(s);
-  WbcReference ref = test::holdReference(st, true, false);
-  ref.foot_pos[3] -= 0.01;
-  ref.foot_vel[3] = -0.15;
+  const StretchingSwing swing = stretchingLeftSwing(-0.475, 0.15, 0.01);
+  const model::RobotStateEstimate& st = swing.st;
+  const WbcReference& ref = swing.ref;
   WbcConfig cfg = test::projectConfig(WbcVariant::Sa);
   cfg.limits.qdd_joint_max_radps2 = 22.0;  // the box this case is built around (the project file's is wider)
   // and the bounds 0.1 rad inside the singularities (profile sa-bounds-inset; the default bounds at the

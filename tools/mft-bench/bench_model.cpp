@@ -51,68 +51,60 @@ std::vector<BenchState> randomStates(const PlanarModel& model, int count) {
   return states;
 }
 
+// One benchmark iteration per state of the cycle in turn: `tick(i)` on state i is timed, then `keep()` (untimed)
+// keeps its results alive for the optimizer.
+template <class Tick, class Keep>
+void timeStateCycle(benchmark::State& state, std::size_t count, Tick&& tick, Keep&& keep) {
+  mft::bench::LatencyRecorder latency;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const std::size_t i = k++ % count;
+    latency.time([&] { tick(i); });
+    keep();
+    benchmark::ClobberMemory();
+  }
+  latency.report(state);
+}
+
 void BM_ModelUpdate(benchmark::State& state) {
   const PlanarModel model = buildBipedModel(benchRobot());
   const std::vector<BenchState> states = randomStates(model, 1024);
   ModelData data;
-  mft::bench::LatencyRecorder latency;
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const BenchState& s = states[k++ % states.size()];
-    latency.time([&] { updateModel(model, s.q, s.qd, &data); });
-    benchmark::DoNotOptimize(data.M.data());
-    benchmark::DoNotOptimize(data.h.data());
-    benchmark::ClobberMemory();
-  }
-  latency.report(state);
+  timeStateCycle(
+      state, states.size(), [&](std::size_t i) { updateModel(model, states[i].q, states[i].qd, &data); },
+      [&] {
+        benchmark::DoNotOptimize(data.M.data());
+        benchmark::DoNotOptimize(data.h.data());
+      });
 }
 BENCHMARK(BM_ModelUpdate);
 
-// What the WBC does after the model update to turn a QP solution into torques: eq. 2-7.
-void BM_ModelClosureProjectionInverseDynamics(benchmark::State& state) {
+// What the WBC does after the model update to turn a QP solution into torques (eq. 2-7), on models updated
+// beforehand; with `with_update` the model update is timed too, into one ModelData: the whole model side of a tick.
+void timeProjectionAndTorques(benchmark::State& state, bool with_update) {
   const PlanarModel model = buildBipedModel(benchRobot());
   const std::vector<BenchState> states = randomStates(model, 1024);
-  std::vector<ModelData> datas(states.size());
-  for (std::size_t i = 0; i < states.size(); ++i) updateModel(model, states[i].q, states[i].qd, &datas[i]);
-  ClosureProjection proj;
-  VectorA tau = VectorA::Zero();
-  mft::bench::LatencyRecorder latency;
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const std::size_t i = k++ % states.size();
-    const BenchState& s = states[i];
-    latency.time([&] {
-      closureProjection(datas[i], &proj);
-      tau = inverseDynamicsActuated(datas[i], proj, s.qdd, s.qd, s.f_c);
-    });
-    benchmark::DoNotOptimize(tau.data());
-    benchmark::ClobberMemory();
-  }
-  latency.report(state);
-}
-BENCHMARK(BM_ModelClosureProjectionInverseDynamics);
-
-// The whole model side of one tick: update, then projection and torques.
-void BM_ModelTick(benchmark::State& state) {
-  const PlanarModel model = buildBipedModel(benchRobot());
-  const std::vector<BenchState> states = randomStates(model, 1024);
+  std::vector<ModelData> datas(with_update ? 0 : states.size());
+  for (std::size_t i = 0; i < datas.size(); ++i) updateModel(model, states[i].q, states[i].qd, &datas[i]);
   ModelData data;
   ClosureProjection proj;
   VectorA tau = VectorA::Zero();
-  mft::bench::LatencyRecorder latency;
-  std::size_t k = 0;
-  for (auto _ : state) {
-    const BenchState& s = states[k++ % states.size()];
-    latency.time([&] {
-      updateModel(model, s.q, s.qd, &data);
-      closureProjection(data, &proj);
-      tau = inverseDynamicsActuated(data, proj, s.qdd, s.qd, s.f_c);
-    });
-    benchmark::DoNotOptimize(tau.data());
-    benchmark::ClobberMemory();
-  }
-  latency.report(state);
+  timeStateCycle(
+      state, states.size(),
+      [&](std::size_t i) {
+        const BenchState& s = states[i];
+        if (with_update) updateModel(model, s.q, s.qd, &data);
+        const ModelData& d = with_update ? data : datas[i];
+        closureProjection(d, &proj);
+        tau = inverseDynamicsActuated(d, proj, s.qdd, s.qd, s.f_c);
+      },
+      [&] { benchmark::DoNotOptimize(tau.data()); });
 }
+
+void BM_ModelClosureProjectionInverseDynamics(benchmark::State& state) { timeProjectionAndTorques(state, false); }
+BENCHMARK(BM_ModelClosureProjectionInverseDynamics);
+
+void BM_ModelTick(benchmark::State& state) { timeProjectionAndTorques(state, true); }
 BENCHMARK(BM_ModelTick);
 
 }  // namespace

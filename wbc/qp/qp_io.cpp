@@ -79,6 +79,26 @@ void readVector(Tokens& t, const std::string& key, Eigen::VectorXd& v, int len) 
   for (int i = 0; i < len; ++i) v[i] = t.number(key.c_str());
 }
 
+// The problem's data records in file order: a matrix of `rows` x n or a vector of `rows` entries (rows from dims).
+struct DataRecord {
+  const char* key;
+  Eigen::MatrixXd QpProblem::*matrix;  // null for a vector
+  Eigen::VectorXd QpProblem::*vector;  // null for a matrix
+  int QpProblem::*rows;
+};
+const DataRecord kDataRecords[] = {
+    {"H", &QpProblem::H, nullptr, &QpProblem::n},       {"g", nullptr, &QpProblem::g, &QpProblem::n},
+    {"Aeq", &QpProblem::Aeq, nullptr, &QpProblem::neq}, {"beq", nullptr, &QpProblem::beq, &QpProblem::neq},
+    {"Ain", &QpProblem::Ain, nullptr, &QpProblem::nin}, {"lbA", nullptr, &QpProblem::lbA, &QpProblem::nin},
+    {"ubA", nullptr, &QpProblem::ubA, &QpProblem::nin}, {"lb", nullptr, &QpProblem::lb, &QpProblem::n},
+    {"ub", nullptr, &QpProblem::ub, &QpProblem::n}};
+
+const DataRecord* dataRecord(const std::string& key) {
+  for (const DataRecord& r : kDataRecords)
+    if (key == r.key) return &r;
+  return nullptr;
+}
+
 void appendNumber(std::string& out, double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.17g", v);  // prints inf / -inf for infinities
@@ -153,24 +173,9 @@ QpInstance parseQpInstance(const std::string& text, const std::string& source) {
       b.length = static_cast<int>(t.integer("block length"));
       if (b.first < 0 || b.length < 0) t.fail("negative " + key + " '" + b.name + "'");
       (key == "varblock" ? inst.varblocks : inst.rowblocks).push_back(b);
-    } else if (key == "H") {
-      readMatrix(t, key, p.H, p.n, p.n);
-    } else if (key == "Aeq") {
-      readMatrix(t, key, p.Aeq, p.neq, p.n);
-    } else if (key == "Ain") {
-      readMatrix(t, key, p.Ain, p.nin, p.n);
-    } else if (key == "g") {
-      readVector(t, key, p.g, p.n);
-    } else if (key == "beq") {
-      readVector(t, key, p.beq, p.neq);
-    } else if (key == "lbA") {
-      readVector(t, key, p.lbA, p.nin);
-    } else if (key == "ubA") {
-      readVector(t, key, p.ubA, p.nin);
-    } else if (key == "lb") {
-      readVector(t, key, p.lb, p.n);
-    } else if (key == "ub") {
-      readVector(t, key, p.ub, p.n);
+    } else if (const DataRecord* r = dataRecord(key)) {
+      if (r->matrix) readMatrix(t, key, p.*(r->matrix), p.*(r->rows), p.n);
+      else readVector(t, key, p.*(r->vector), p.*(r->rows));
     } else if (key == "x_ref") {
       inst.x_ref.emplace();
       readVector(t, key, *inst.x_ref, p.n);
@@ -189,8 +194,10 @@ QpInstance parseQpInstance(const std::string& text, const std::string& source) {
   }
   if (!ended) t.fail("missing 'end' record");
   if (!t.atEnd()) t.fail("text after 'end'");
-  for (const char* required : {"name", "dims", "H", "g", "Aeq", "beq", "Ain", "lbA", "ubA", "lb", "ub"})
+  for (const char* required : {"name", "dims"})
     if (!seen.count(required)) t.fail(std::string("missing record '") + required + "'");
+  for (const DataRecord& r : kDataRecords)
+    if (!seen.count(r.key)) t.fail(std::string("missing record '") + r.key + "'");
   for (const QpBlock& b : inst.varblocks)
     if (b.first + b.length > p.n) t.fail("varblock '" + b.name + "' exceeds n");
   checkProblemData(p, source);
@@ -251,15 +258,10 @@ std::string formatQpInstance(const QpInstance& inst) {
     out += "varblock " + b.name + ' ' + std::to_string(b.first) + ' ' + std::to_string(b.length) + '\n';
   for (const QpBlock& b : inst.rowblocks)
     out += "rowblock " + b.name + ' ' + std::to_string(b.first) + ' ' + std::to_string(b.length) + '\n';
-  appendMatrix(out, "H", p.H);
-  appendVector(out, "g", p.g);
-  appendMatrix(out, "Aeq", p.Aeq);
-  appendVector(out, "beq", p.beq);
-  appendMatrix(out, "Ain", p.Ain);
-  appendVector(out, "lbA", p.lbA);
-  appendVector(out, "ubA", p.ubA);
-  appendVector(out, "lb", p.lb);
-  appendVector(out, "ub", p.ub);
+  for (const DataRecord& r : kDataRecords) {
+    if (r.matrix) appendMatrix(out, r.key, p.*(r.matrix));
+    else appendVector(out, r.key, p.*(r.vector));
+  }
   if (inst.x_ref) appendVector(out, "x_ref", *inst.x_ref);
   if (inst.f_ref) {
     out += "f_ref ";

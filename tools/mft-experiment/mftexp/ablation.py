@@ -14,13 +14,12 @@ import csv
 import json
 import re
 import shutil
-import time
 from dataclasses import asdict
 from pathlib import Path
 
 from .common import CONTROLLER_NAMES, ExperimentError, log, pyplot
 from .report import ratio
-from .sweep import Sweep, Variant, ikey
+from .sweep import Sweep, Variant
 
 RULE_VARIANT = "rule-no-fall"
 

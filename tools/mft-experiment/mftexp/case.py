@@ -10,6 +10,22 @@ from . import push as pushmod
 COLORS = {"mft": "tab:blue", "sa": "tab:orange", "none": "tab:gray"}
 
 
+def controller_runs(args, kind, write, timeout_s):
+    """The output folder (args.out or runs/<kind>-<time>) and one checked scenario per controller in it, written by
+    write(path, controller): the jobs [(controller, scenario, run_dir, rawlog, timeout)] of run_pair."""
+    out = Path(args.out or REPO / "runs" / f"{kind}-{time.strftime('%Y%m%d-%H%M%S')}")
+    out.mkdir(parents=True, exist_ok=True)
+    jobs = []
+    for c in args.controllers:
+        rd = out / f"{c}-run"
+        rd.mkdir(exist_ok=True)
+        scen = rd / "scenario.yaml"
+        write(scen, c)
+        check_scenario(args.bin_dir, args.config_dir, scen, profiles=args.profile)
+        jobs.append((c, scen, rd, out / f"{c}.rawlog", timeout_s))
+    return out, jobs
+
+
 def run_pair(args, jobs):
     """Runs [(name, scenario, run_dir, rawlog)] on args.workers stacks; returns {name: (summary, wall)}."""
     results, errors = {}, []
@@ -52,16 +68,9 @@ def run_pair(args, jobs):
 
 
 def cmd_case(args, setup):
-    out = Path(args.out or REPO / "runs" / f"case-{time.strftime('%Y%m%d-%H%M%S')}")
-    out.mkdir(parents=True, exist_ok=True)
-    jobs = []
-    for c in args.controllers:
-        rd = out / f"{c}-run"
-        rd.mkdir(exist_ok=True)
-        scen = rd / "scenario.yaml"
-        pushmod.write_scenario(scen, setup, args.height, c, args.impulse)
-        check_scenario(args.bin_dir, args.config_dir, scen, profiles=args.profile)
-        jobs.append((c, scen, rd, out / f"{c}.rawlog", setup.duration_s * 40 + 120))
+    out, jobs = controller_runs(args, "case", lambda scen, c: pushmod.write_scenario(scen, setup, args.height, c,
+                                                                                      args.impulse),
+                                setup.duration_s * 40 + 120)
     t0 = time.monotonic()
     runs = run_pair(args, jobs)
     report = {"height_m": args.height, "impulse_Ns": args.impulse, "direction": setup.direction,

@@ -8,8 +8,8 @@ import time
 from pathlib import Path
 
 from . import push as _push, sweep as _sweep, video as _video
-from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, check_setup, log,
-                     fmt_duration, snapshot_binaries)
+from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, bounded, check_setup,
+                     log, fmt_duration, snapshot_binaries)
 
 HEIGHT_RANGE = (0.30, 0.46)
 DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the real multi-process stack, in lockstep.
@@ -70,14 +70,7 @@ def height(text):
     return heights_list(text)[0]
 
 
-def domain_id(text):
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}")
-    if not 0 <= v <= 232:
-        raise argparse.ArgumentTypeError(f"DDS domain id must be 0..232: {v}")
-    return v
+domain_id = bounded(int, 0, 232, "DDS domain id must be 0..232: {v}")
 
 
 def add_common(p, workers=True):

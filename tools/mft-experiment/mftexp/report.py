@@ -1,6 +1,5 @@
 """Table II (Markdown, CSV) and the sweep plot from the cell lines of results.jsonl."""
 import csv
-import json
 from pathlib import Path
 
 from .common import PAPER_TABLE2, pyplot

@@ -9,9 +9,9 @@ import math
 import time
 from pathlib import Path
 
-from .common import (CONTROLLER_NAMES, REPO, ExperimentError, check_scenario, export_csv, pyplot, read_csv,
-                     write_report, write_yaml_scenario)
-from .case import COLORS, run_pair
+from .common import (CONTROLLER_NAMES, ExperimentError, export_csv, pyplot, read_csv, write_report,
+                     write_yaml_scenario)
+from .case import COLORS, controller_runs, run_pair
 
 INSIDE_TOL_RAD = 0.01  # "stayed inside" allows the soft constraint's small predicted violations
 # The minimal departure from the paper's setup that the course needs (docs/experiments.md#terrain-fig-8): with the
@@ -104,16 +104,8 @@ def cmd_terrain(args):
     slopes = [s for s in segs if s[0] == "slope" and s[4] > s[3]]
     # walking starts at 2 s; blind walking over the course averages well below the command (0.5 of it allowed)
     duration = args.duration or min(300.0, round(2.0 + course_end / (0.5 * args.speed) + 3.0, 1))
-    out = Path(args.out or REPO / "runs" / f"terrain-{time.strftime('%Y%m%d-%H%M%S')}")
-    out.mkdir(parents=True, exist_ok=True)
-    jobs = []
-    for c in args.controllers:
-        rd = out / f"{c}-run"
-        rd.mkdir(exist_ok=True)
-        scen = rd / "scenario.yaml"
-        write_yaml_scenario(scen, scenario(args, c, duration))
-        check_scenario(args.bin_dir, args.config_dir, scen, profiles=args.profile)
-        jobs.append((c, scen, rd, out / f"{c}.rawlog", duration * 20 + 120))
+    out, jobs = controller_runs(args, "terrain", lambda scen, c: write_yaml_scenario(scen, scenario(args, c, duration)),
+                                duration * 20 + 120)
     t0 = time.monotonic()
     runs = run_pair(args, jobs)
     rows, b, verts = leg_polygon(args.config_dir)

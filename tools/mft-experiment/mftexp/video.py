@@ -1,22 +1,14 @@
 """Run videos of an experiment's recorded runs, side by side on one clock (`mft-export A --video OUT --beside B`,
 docs/videos.md): `case` shows the same push with both controllers (the paper's Fig. 6 in motion), `terrain` the
 course. --no-video skips them."""
-import argparse
 import json
 import subprocess
 from pathlib import Path
 
-from .common import ExperimentError, log
+from .common import ExperimentError, bounded, log
 
 
-def video_speed(text):
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}")
-    if not 0.01 <= v <= 1000:
-        raise argparse.ArgumentTypeError(f"must be in [0.01, 1000]: {text!r}")
-    return v
+video_speed = bounded(float, 0.01, 1000, "must be in [0.01, 1000]: {t}")
 
 
 def add_video_options(p):

@@ -100,3 +100,13 @@ function(mft_add_python_test name)
     set_tests_properties(${name} PROPERTIES ENVIRONMENT "MFT_BIN_DIR=${PROJECT_BINARY_DIR}/bin")
   endif()
 endfunction()
+
+# Every subfolder of the current one that has a CMakeLists.txt (tests/ and tools/: one folder per area or tool).
+macro(mft_add_subfolders)
+  file(GLOB _mft_subfolders LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  foreach(_mft_dir ${_mft_subfolders})
+    if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${_mft_dir} AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${_mft_dir}/CMakeLists.txt)
+      add_subdirectory(${_mft_dir})
+    endif()
+  endforeach()
+endmacro()

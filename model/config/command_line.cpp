@@ -40,6 +40,14 @@ void CommandLine::fail(const std::string& message) const {
   std::exit(2);
 }
 
+std::string CommandLine::takeLeadingArgument(int* argc, char** argv) {
+  if (*argc < 2 || std::string(argv[1]).rfind("--", 0) == 0) return "";
+  std::string first = argv[1];
+  for (int i = 1; i + 1 < *argc; ++i) argv[i] = argv[i + 1];
+  --*argc;
+  return first;
+}
+
 void CommandLine::parse(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];

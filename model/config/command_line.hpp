@@ -23,6 +23,9 @@ class CommandLine {
   double getDouble(const std::string& name, double lo, double hi) const;
   std::string usage() const;
   [[noreturn]] void fail(const std::string& message) const;
+  // `tool FILE [options]`: the parser takes options only, so a leading positional argument is taken off argv
+  // first. Returns it ("" if argv[1] is missing or an option).
+  static std::string takeLeadingArgument(int* argc, char** argv);
 
  private:
   struct Spec {

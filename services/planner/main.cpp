@@ -109,14 +109,15 @@ static int toolMain(int argc, char** argv) {
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
-  char head[256];
-  std::snprintf(head, sizeof head, "{\"service\": \"mft-planner\", \"ticks\": %llu, \"last_tick\": %llu, \"steps\": %llu, "
-                "\"rejected_commands\": %llu, \"operator_commands\": ", static_cast<unsigned long long>(join.ticks()),
-                static_cast<unsigned long long>(join.lastTick()), static_cast<unsigned long long>(node->output().step_index),
-                static_cast<unsigned long long>(scenario_rejected + inbox.rejected()));
-  ctx.writeSummary(std::string(head) + inbox.countsJson() + ", " + join.countsJson() + ", \"deadline_misses\": " +
-                   std::to_string(state_reader.requestedDeadlineMisses()) + ", \"update_time_us\": " + update_us.json() +
-                   ", \"live_changes\": " + tuning.summaryJson() + "}");
+  config::JsonWriter w;
+  w.beginObject().field("service", "mft-planner").field("ticks", join.ticks()).field("last_tick", join.lastTick());
+  w.field("steps", node->output().step_index).field("rejected_commands", scenario_rejected + inbox.rejected());
+  w.key("operator_commands");
+  inbox.writeCounts(w);
+  join.writeCounts(w);
+  w.field("deadline_misses", state_reader.requestedDeadlineMisses()).key("update_time_us").raw(update_us.json());
+  w.key("live_changes").raw(tuning.summaryJson());
+  ctx.writeSummary(w.endObject().str());
   return 0;
 }
 

@@ -45,12 +45,9 @@ void OperatorInbox::applyPending(planner::MotionPlanner& planner, std::uint64_t 
   pending_count_ = 0;
 }
 
-std::string OperatorInbox::countsJson() const {
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "{\"received\": %llu, \"rejected\": %llu, \"applied\": %llu, \"waiting\": %zu}",
-                static_cast<unsigned long long>(received_), static_cast<unsigned long long>(rejected_),
-                static_cast<unsigned long long>(applied_), pending_count_);
-  return buf;
+void OperatorInbox::writeCounts(config::JsonWriter& w) const {
+  w.beginObject().field("received", received_).field("rejected", rejected_).field("applied", applied_);
+  w.field("waiting", pending_count_).endObject();
 }
 
 }  // namespace mft::services

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "idl/msg_types.hpp"
+#include "model/config/json_writer.hpp"
 #include "planner/motion_planner.hpp"
 #include "services/runtime/command_verdict.hpp"
 
@@ -28,7 +29,7 @@ class OperatorInbox {
 
   std::uint64_t rejected() const { return rejected_; }
   // {"received": N, "rejected": N, "applied": N, "waiting": N}
-  std::string countsJson() const;
+  void writeCounts(config::JsonWriter& w) const;  // {received, rejected, applied, waiting} as a value
 
  private:
   struct Pending {

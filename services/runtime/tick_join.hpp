@@ -60,14 +60,6 @@ class TickJoin {
   void writeCounts(config::JsonWriter& w) const {
     w.field("refused_inputs", refused_inputs_).field("refused_ticks", gate_.refused()).field("new_clocks", gate_.newClocks());
   }
-  // The same fields without the braces, for a summary still assembled as text (the planner's and the WBC's).
-  std::string countsJson() const {
-    config::JsonWriter w;
-    w.beginObject();
-    writeCounts(w);
-    const std::string& object = w.endObject().str();
-    return object.substr(1, object.size() - 2);
-  }
 
  private:
   const char* service_;

@@ -24,14 +24,6 @@ namespace {
 constexpr int kExitBadInput = 2;
 constexpr int kExitCorrupt = 4;
 
-std::string takeFile(int* argc, char** argv) {
-  if (*argc < 2 || std::string(argv[1]).rfind("--", 0) == 0) return "";
-  std::string f = argv[1];
-  for (int i = 1; i + 1 < *argc; ++i) argv[i] = argv[i + 1];
-  --*argc;
-  return f;
-}
-
 
 struct LabelInfo {
   std::uint64_t count = 0;
@@ -51,7 +43,7 @@ void prepareOutputDir(const services::CommandLine& cli, const std::string& optio
 }
 
 int exportMain(int argc, char** argv) {
-  std::string file = takeFile(&argc, argv);
+  std::string file = config::CommandLine::takeLeadingArgument(&argc, argv);
   services::CommandLine cli(
       "mft-export FILE",
       "Export an mft rawlog: --csv DIR writes <DIR>/<label>.csv (stamp_ns, time_s, then the named channels at\n"

@@ -37,15 +37,6 @@ constexpr int kExitMismatch = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitCorrupt = 4;
 
-// `mft-replay FILE [options]`: the shared CommandLine takes options only, so the file is taken off first.
-std::string takeFile(int* argc, char** argv) {
-  if (*argc < 2 || std::string(argv[1]).rfind("--", 0) == 0) return "";
-  std::string f = argv[1];
-  for (int i = 1; i + 1 < *argc; ++i) argv[i] = argv[i + 1];
-  --*argc;
-  return f;
-}
-
 
 // ------------------------------------------------------------------------------------------ --through-wbc
 // The WBC changes applied while the run was recorded (live tuning, docs/live-tuning.md): a first pass over the
@@ -382,7 +373,7 @@ class ReadAhead {
 }  // namespace
 
 static int toolMain(int argc, char** argv) {
-  std::string file = takeFile(&argc, argv);
+  std::string file = config::CommandLine::takeLeadingArgument(&argc, argv);
   services::CommandLine cli(
       "mft-replay FILE",
       "Play an mft rawlog back onto the DDS topics with its recorded timing, or (--through-wbc) run the recorded\n"

@@ -127,6 +127,15 @@ def add_push_setup(p):
     g.add_argument("--min-touchdowns", type=int, default=2, help="recovered: touchdowns in the last 1 s (still stepping)")
 
 
+def add_study_options(p, kind):
+    """What every resumable study (push-sweep, ablation) takes: its folder, the push set-up, the stacks and the
+    executor."""
+    p.add_argument("--out", help=f"output folder; an existing one is resumed (default runs/{kind}-<time>)")
+    add_push_setup(p)
+    add_common(p)
+    add_distributed(p)
+
+
 def add_search(p, default):
     p.add_argument("--search", choices=("linear", "coarse", "bisect"), default=default,
                    help=f"linear: the paper's scan, exact; coarse: --coarse steps, then the step grid at the first "
@@ -175,10 +184,7 @@ def build_parser():
     add_search(s, "linear")
     s.add_argument("--no-rawlogs", dest="keep_rawlogs", action="store_false",
                    help="do not keep the rawlogs of each cell's boundary runs")
-    s.add_argument("--out", help="output folder; an existing one is resumed (default runs/experiment-<time>)")
-    add_push_setup(s)
-    add_common(s)
-    add_distributed(s)
+    add_study_options(s, "experiment")
 
     c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
                        description="One push at one height with both controllers (recorded), and the paper's "
@@ -228,10 +234,7 @@ def build_parser():
                    default=[1e1, 1e2, 1e3, 1e4, 1e5], help="sensitivity values (default 1e1,1e2,1e3,1e4,1e5)")
     a.add_argument("--sensitivity-height", type=height, default=0.44, help="sensitivity height [m] (default 0.44)")
     a.add_argument("--no-sensitivity", dest="sensitivity", action="store_false", help="skip the sensitivity")
-    a.add_argument("--out", help="output folder; an existing one is resumed (default runs/ablation-<time>)")
-    add_push_setup(a)
-    add_common(a)
-    add_distributed(a)
+    add_study_options(a, "ablation")
 
     w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/experiments.md)",
                        description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "

@@ -28,7 +28,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
 from mftstack.scripts import run_script, script_parser  # noqa: E402
 from mftstack.paths import REPO, SUPERVISOR  # noqa: E402
-from mftstack.testing import pid_alive  # noqa: E402
+from mftstack.testing import child_processes, pid_alive  # noqa: E402
 
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
 TOPICS = ["SensorData", "GroundTruth", "RobotState", "OperatorCommand", "Reference", "JointCommand",
@@ -44,19 +44,7 @@ def log(msg, quiet=False):
 
 def children(ppid, name):
     """Pids of the live children of `ppid` running `name` (the supervisor's restarted service)."""
-    out = []
-    for d in Path("/proc").iterdir():
-        if not d.name.isdigit():
-            continue
-        try:
-            stat = (d / "stat").read_text()
-        except OSError:
-            continue
-        comm = stat[stat.index("(") + 1:stat.rindex(")")]
-        fields = stat[stat.rindex(")") + 2:].split()
-        if fields[1] == str(ppid) and fields[0] != "Z" and name.startswith(comm):
-            out.append(int(d.name))
-    return out
+    return [pid for pid, comm, state, _ in child_processes(ppid) if state != "Z" and name.startswith(comm)]
 
 
 def read_json(path):

@@ -19,7 +19,7 @@ from .paths import DEFAULT_CONFIG as CONFIG
 from .paths import REPO, SCENARIOS, SUPERVISOR
 
 __all__ = ["BIN", "CONFIG", "REPO", "SCENARIOS", "SUPERVISOR", "StackRunner", "StackTestCase", "StackUpTestCase", "mft_cmd",
-           "pid_alive", "processes_mentioning"]
+           "child_processes", "pid_alive", "processes_mentioning"]
 
 
 def mft_cmd(domain, *args, timeout=60):
@@ -32,6 +32,24 @@ def mft_cmd(domain, *args, timeout=60):
     except ValueError:
         result = None
     return p.returncode, result, p.stderr, time.monotonic() - t0
+
+
+def child_processes(ppid):
+    """[(pid, comm, state, command line)] of the children of ppid, from /proc (those that vanish while being read
+    are left out)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            stat = (d / "stat").read_text()
+            fields = stat[stat.rindex(")") + 2:].split()
+            if int(fields[1]) == ppid:
+                cmd = (d / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+                out.append((int(d.name), stat[stat.index("(") + 1:stat.rindex(")")], fields[0], cmd))
+        except (OSError, ValueError, IndexError):
+            continue
+    return out
 
 
 def processes_mentioning(text):

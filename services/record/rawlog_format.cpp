@@ -351,13 +351,15 @@ bool parseTopic(const std::string& name, Topic* out) {
   return false;
 }
 
+// Events (operator commands, pushes, live changes) carry a sequence number instead of a tick, and no stamp.
+template <class T>
+constexpr bool kIsEvent = std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance> ||
+                          std::is_same_v<T, msg::ConfigChange>;
+
 std::uint64_t tickOf(const Message& m) {
   return std::visit(
       [](const auto& x) -> std::uint64_t {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance> ||
-                      std::is_same_v<T, msg::ConfigChange>)
-          return x.seq();
+        if constexpr (kIsEvent<std::decay_t<decltype(x)>>) return x.seq();
         else return x.tick();
       },
       m);
@@ -366,10 +368,7 @@ std::uint64_t tickOf(const Message& m) {
 std::uint64_t stampOf(const Message& m) {
   return std::visit(
       [](const auto& x) -> std::uint64_t {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, msg::OperatorCommand> || std::is_same_v<T, msg::Disturbance> ||
-                      std::is_same_v<T, msg::ConfigChange>)
-          return 0;
+        if constexpr (kIsEvent<std::decay_t<decltype(x)>>) return 0;
         else return x.stamp_ns();
       },
       m);

@@ -31,7 +31,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "distributed"))
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from testnet import TestNet, netns_permitted  # noqa: E402
-from mftstack.testing import BIN, REPO, pid_alive, processes_mentioning  # noqa: E402
+from mftstack.testing import BIN, REPO, child_processes, pid_alive, processes_mentioning  # noqa: E402
 
 TOOL = REPO / "tools" / "mft-experiment" / "mft-experiment"
 PY = "/usr/bin/python3" if Path("/usr/bin/python3").exists() else sys.executable
@@ -75,17 +75,7 @@ def _die_with_test():
 
 def children(pid):
     """[(pid, command line)] of the children of pid."""
-    out = []
-    for p in Path("/proc").iterdir():
-        if not p.name.isdigit():
-            continue
-        try:
-            stat = (p / "stat").read_text()
-            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
-                out.append((int(p.name), (p / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")))
-        except (OSError, ValueError, IndexError):
-            continue
-    return out
+    return [(c, cmd) for c, _, _, cmd in child_processes(pid)]
 
 
 class Cluster:

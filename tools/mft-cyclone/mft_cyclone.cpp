@@ -181,6 +181,15 @@ static int cmd_listen(int domain, double seconds, long min_samples, const char *
   return EXIT_OK;
 }
 
+/* The QoS of the stack's event topics (operator commands, verdicts): reliable, transient local, the last `depth`. */
+static dds_qos_t *reliable_transient_local(int32_t depth) {
+  dds_qos_t *q = dds_create_qos();
+  dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+  return q;
+}
+
 static int cmd_command(int domain, int mode, double height, double speed, double wait_s, const char *prefix,
                        bool json) {
   dds_entity_t participant = make_participant(domain);
@@ -194,17 +203,11 @@ static int cmd_command(int domain, int mode, double height, double speed, double
   /* The verdict reader first, so that the answer cannot come before it exists (the planner's writer keeps its
    * history for late readers anyway: reliable, transient-local). */
   dds_entity_t t_verdict = dds_create_topic(participant, &mft_msg_dds__CommandVerdict__desc, n_verdict, NULL, NULL);
-  dds_qos_t *rq = dds_create_qos();
-  dds_qset_reliability(rq, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_durability(rq, DDS_DURABILITY_TRANSIENT_LOCAL);
-  dds_qset_history(rq, DDS_HISTORY_KEEP_LAST, 16);
+  dds_qos_t *rq = reliable_transient_local(16);
   const dds_entity_t r_verdict = dds_create_reader(participant, t_verdict, rq, NULL);
   dds_delete_qos(rq);
   dds_entity_t t_command = dds_create_topic(participant, &mft_msg_dds__OperatorCommand__desc, n_command, NULL, NULL);
-  dds_qos_t *wq = dds_create_qos();
-  dds_qset_reliability(wq, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_durability(wq, DDS_DURABILITY_TRANSIENT_LOCAL);
-  dds_qset_history(wq, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qos_t *wq = reliable_transient_local(1);
   const dds_entity_t writer = dds_create_writer(participant, t_command, wq, NULL);
   dds_delete_qos(wq);
   if (r_verdict < 0 || writer < 0) {

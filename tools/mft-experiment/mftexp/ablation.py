@@ -17,7 +17,7 @@ import shutil
 from dataclasses import asdict
 from pathlib import Path
 
-from .common import CONTROLLER_NAMES, ExperimentError, log, pyplot
+from .common import CONTROLLER_NAMES, ExperimentError, pyplot
 from .report import ratio
 from .sweep import Sweep, Variant
 
@@ -118,10 +118,9 @@ def cmd_ablation(args, setup):
 
     jobs = [stepping_job(v, c) for v in [variants[0]] + sens_variants for c in args.controllers]
     from .cli import load_text
-    load0 = load_text()
-    log(f"ablation into {args.out}: {len(variants)} variants x heights {args.heights} + {len(sens_variants)} values of "
-        f"{args.param} at {args.sensitivity_height} m, controllers {args.controllers}, search {args.search}, "
-        + ("in process, " if args.inprocess else "") + sweep.executor.describe() + f"; load average {load0}")
+    load0 = sweep.announce(f"ablation into {args.out}: {len(variants)} variants x heights {args.heights} + "
+                           f"{len(sens_variants)} values of {args.param} at {args.sensitivity_height} m, controllers "
+                           f"{args.controllers}, search {args.search}, ")
     wall = None
     try:
         wall = sweep.run(jobs)

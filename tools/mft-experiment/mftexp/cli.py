@@ -315,10 +315,8 @@ def cmd_push_sweep(args):
     if args.inprocess:
         args.keep_rawlogs = False
     sweep = Sweep(args, setup)
-    load0 = load_text()
-    log(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
-        f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), "
-        + ("in process, " if args.inprocess else "") + sweep.executor.describe() + f"; load average {load0}")
+    load0 = sweep.announce(f"push-sweep into {args.out}: heights {args.heights}, controllers {args.controllers}, "
+                           f"{args.direction} push, grid {args.start:g}+k*{args.step:g} N s ({args.search}), ")
     wall = None
     try:
         wall = sweep.run()

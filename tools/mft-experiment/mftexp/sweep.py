@@ -416,6 +416,14 @@ class Sweep:
         return cell_rec
 
     # ------------------------------------------------------------------------------------------------- all
+    def announce(self, what):
+        """Logs the start of a study (`what`, then where its runs go and the load average); returns the load text."""
+        from .cli import load_text
+        load0 = load_text()
+        log(what + ("in process, " if self.args.inprocess else "") + self.executor.describe()
+            + f"; load average {load0}")
+        return load0
+
     def run(self, extra_jobs=()):
         """Searches every cell not on file; `extra_jobs` are callables job(slot) run by the same slots."""
         todo = [c for c in self.cells if c not in self.results.cells]

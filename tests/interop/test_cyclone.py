@@ -22,6 +22,10 @@ ROBOT = yaml.safe_load((CONFIG / "robot.yaml").read_text())
 PEAK_TORQUE = ROBOT["actuator"]["gear_ratio"] * ROBOT["actuator"]["motor_peak_torque_Nm"]
 SCENARIO_HEIGHT = 0.42  # step-in-place.yaml
 NEW_HEIGHT = 0.40
+# The planner moves its height reference toward a new command at most this fast, so the Reference reaches
+# NEW_HEIGHT this many ticks (1 kHz) after the command's tick, plus a few ticks for rounding.
+HEIGHT_RATE = yaml.safe_load((CONFIG / "planner.yaml").read_text())["command"]["height_rate_mps"]
+RAMP_TICKS = math.ceil(abs(SCENARIO_HEIGHT - NEW_HEIGHT) / HEIGHT_RATE * 1000) + 5
 
 
 def cyclone(*args, timeout=90):
@@ -73,14 +77,16 @@ class CycloneOnTheStack(StackUpTestCase):
         self.assertEqual((code, r["result"]), (0, "applied"), (r, err))
         self.assertIn("height 0.400 m", r["reason"])
         applied_tick = r["tick"]
-        # The planner's Reference follows from the applied tick on (bounded wait for samples past it).
+        # The planner's Reference ramps from the applied tick on and holds NEW_HEIGHT after RAMP_TICKS (bounded
+        # wait for samples past the ramp: a window that starts inside it sees the ramp, not the command).
+        settled_tick = applied_tick + RAMP_TICKS
         deadline = time.monotonic() + 60
         while True:
             topics = self.listen(200)
             ref = topics["Reference"]
-            if ref["first_tick"] >= applied_tick or time.monotonic() > deadline:
+            if ref["first_tick"] >= settled_tick or time.monotonic() > deadline:
                 break
-        self.assertGreaterEqual(ref["first_tick"], applied_tick, "no Reference after the applied tick within 60 s")
+        self.assertGreaterEqual(ref["first_tick"], settled_tick, "no Reference after the height ramp within 60 s")
         self.assertAlmostEqual(ref["min"], NEW_HEIGHT, delta=1e-9)
         self.assertAlmostEqual(ref["max"], NEW_HEIGHT, delta=1e-9)
 

@@ -42,7 +42,7 @@ from .checks import (DOMAIN_CHECKED_ENV, check_before_start, check_common, check
 from .errors import Interrupted, SupervisorError, error_text, log
 from .paths import DEFAULT_BIN, DEFAULT_CONFIG, DEFAULT_RUNS
 from .processes import (ANSI_ESCAPE, READY_TIMEOUT_S, SECURE_RUN_ATTEMPTS, SECURE_START_TIMEOUT_S, STOP_GRACE_S, Stack,
-                        pid_alive, read_json, tail, write_atomically)
+                        pid_alive, process_start_time, read_json, tail, watch_process, write_atomically)
 from .summary import build_summary, print_summary, report_unwritten, write_summary_file
 
 # On Ctrl-C the children get this long to stop before SIGKILL (an interrupted start must end promptly).
@@ -177,6 +177,8 @@ def cmd_up(args):
         st = read_json(sf)
         if pid_alive(st.get("supervisor_pid")):
             raise SupervisorError(f"a stack is already up on domain {args.domain}{on} (supervisor pid {st['supervisor_pid']})")
+    if args.watch_pid is not None and process_start_time(args.watch_pid) is None:
+        raise SupervisorError(f"--watch-pid {args.watch_pid}: no such process")
     check_before_start(args)
     if not args.foreground:
         # Detach: re-run this command in the foreground in a new session, logging to the runs folder.
@@ -203,6 +205,8 @@ def cmd_up(args):
         raise SupervisorError("the stack did not come up in time")
     args.forever = True
     stop = stop_on_signals()
+    if args.watch_pid is not None:
+        watch_process(args.watch_pid, stop, f"the stack on domain {args.domain}{on}")
     stack = Stack(args, scenario)
     stack.stop_flag = stop
     started = time.time()
@@ -356,6 +360,8 @@ def main(argv=None):
     sp = sub.add_parser("up", help="start a long-running stack in the background")
     stack_options(sp)
     sp.add_argument("--foreground", action="store_true", help="stay in the foreground")
+    sp.add_argument("--watch-pid", type=int, metavar="PID", help="take the stack down when process PID ends (a test "
+                    "passes its own pid, so a test killed by a timeout leaves no stack behind)")
     sp.set_defaults(func=cmd_up)
     for name, func, hlp in (("status", cmd_status, "show the stack of a domain (exit 2 when none is up)"),
                             ("down", cmd_down, "stop the stack of a domain (exit 0 when none is up: nothing runs "

@@ -350,6 +350,31 @@ def read_json(path):
         return {}
 
 
+def process_start_time(pid):
+    """The start time of a live process (clock ticks since boot, /proc/PID/stat field 22), or None when it has
+    ended or is a zombie: with the pid it identifies one process, so a reused pid is not mistaken for it."""
+    try:
+        fields = Path(f"/proc/{int(pid)}/stat").read_text().rsplit(")", 1)[1].split()
+    except (OSError, ValueError, IndexError):
+        return None
+    return None if fields[0] in ("Z", "X") else int(fields[19])
+
+
+def watch_process(pid, stop, what):
+    """Sets `stop` when process pid ends (polled every 0.2 s by a daemon thread). Raises SupervisorError when it
+    is not running now."""
+    started = process_start_time(pid)
+    if started is None:
+        raise SupervisorError(f"--watch-pid {pid}: no such process")
+
+    def poll():
+        while not stop.wait(0.2):
+            if process_start_time(pid) != started:
+                log(f"the watched process {pid} has ended: stopping {what}")
+                stop.set()
+    threading.Thread(target=poll, daemon=True).start()
+
+
 def pid_alive(pid):
     if not pid:
         return False

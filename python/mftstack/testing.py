@@ -93,6 +93,8 @@ class StackRunner:
         if args[0] in ("run", "up"):
             cmd += ["--bin-dir", str(self.bin_dir)]
             cmd += ["--config-dir", str(self.config_dir)] if self.config_dir else []
+        if args[0] == "up":  # a test killed by CTest's timeout leaves no stack behind
+            cmd += ["--watch-pid", str(os.getpid())]
         return cmd
 
     def start(self, *args, env=None):

@@ -157,6 +157,36 @@ class SupervisorTest(FakeStack, unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("no stack is up on domain 11", r.stderr)
 
+    def test_up_goes_down_when_the_watched_process_ends(self):
+        # A test killed by CTest's timeout passes its pid to `up --watch-pid`: its stack must not outlive it.
+        env = dict(self.env, FAKE_SERVICES="")
+        base = [sys.executable, str(SUPERVISOR)]
+        opts = ["--bin-dir", str(self.bin), "--config-dir", str(self.cfg)]
+        r = subprocess.run(base + ["up", str(self.scenario), "--domain", "33", "--watch-pid", "999999999"] + opts,
+                           env=env, capture_output=True, text=True, timeout=60)
+        self.assertEqual((r.returncode, r.stderr.strip()),
+                         (2, "mft-supervisor: error: --watch-pid 999999999: no such process"))
+        self.assertEqual(self.started_pids(), [])
+        watched = subprocess.Popen(["sleep", "120"])
+        self.procs.append(watched)
+        r = subprocess.run(base + ["up", str(self.scenario), "--domain", "33", "--watch-pid", str(watched.pid)] + opts,
+                           env=env, capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        services = self.started_pids()
+        self.assertEqual(len(services), 4, services)
+        state = self.tmp / "runs" / "stack-d33.json"
+        supervisor_pid = json.loads(state.read_text())["supervisor_pid"]
+        watched.kill()
+        watched.wait()
+        deadline = time.time() + 20  # 0.2 s polling plus the services' orderly stop
+        while (pid_alive(supervisor_pid) or any(pid_alive(p) for p in services)) and time.time() < deadline:
+            time.sleep(0.05)
+        self.assertFalse(pid_alive(supervisor_pid), "the supervisor outlived the watched process by 20 s")
+        self.assertEqual([p for p in services if pid_alive(p)], [], "services outlived the watched process")
+        self.assertFalse(state.exists(), "the state file of a stack that is down")
+        log = (self.tmp / "runs" / "supervisor-d33.log").read_text()
+        self.assertIn(f"the watched process {watched.pid} has ended: stopping the stack on domain 33", log)
+
     def test_chain_cpu_pins_the_chain_and_gives_the_recorder_the_other_cpus(self):
         allowed = sorted(os.sched_getaffinity(0))
         chain_cpu = allowed[-1]

@@ -369,16 +369,13 @@ void closureProjection(const ModelData& data, ClosureProjection* out) {
 }
 
 bool actuatedTorqueMap(const ModelData& data, const ClosureProjection& proj, ActuatedTorqueMap* out) {
-  Eigen::Matrix<double, kNa, kNq> SaNhT;    // S_a N_h' (rows of N_h' are columns of N_h)
-  Eigen::Matrix<double, kNa, kNq> SaM;      // S_a M
-  Eigen::Matrix<double, kNa, kNh> SaJhT;    // S_a J_h'
+  // The actuated rows of (7): S_a M, S_a N_h', S_a J_h'.
+  ProjectedDynamicsRows<kNa> actuated;
+  projectedDynamicsRows<kNa>(data, proj, kActuatedIndex, &actuated);
+  const Eigen::Matrix<double, kNa, kNq>& SaNhT = actuated.NhT;
+  const Eigen::Matrix<double, kNa, kNq>& SaM = actuated.M;
+  const Eigen::Matrix<double, kNa, kNh>& SaJhT = actuated.JhT;
   Eigen::Matrix<double, kNa, kNa> SaNhTSaT;  // S_a N_h' S_a'
-  for (int i = 0; i < kNa; ++i) {
-    const int j = kActuatedIndex[i];
-    SaNhT.row(i) = proj.N_h.col(j).transpose();
-    SaM.row(i) = data.M.row(j);
-    SaJhT.row(i) = data.Jh.col(j).transpose();
-  }
   for (int k = 0; k < kNa; ++k) SaNhTSaT.col(k) = SaNhT.col(kActuatedIndex[k]);
   // 4x4 with a closed-form inverse in Eigen: no pivoting search, no allocation.
   const Eigen::Matrix<double, kNa, kNa> K = SaNhTSaT.inverse();

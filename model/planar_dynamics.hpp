@@ -8,6 +8,7 @@
 // Body frames: a link's origin is its proximal joint and the link lies along its local -z axis, so a link at
 // absolute CCW angle a points along (sin a, -cos a). The torso frame is the base frame (origin on the hip axis).
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "model/coordinates.hpp"
@@ -108,6 +109,30 @@ struct ClosureProjection {
   MatrixQ Minv;
 };
 void closureProjection(const ModelData& data, ClosureProjection* out);
+
+// Paper (7), the closure-projected equations of motion (f_h eliminated with N_h and Lambda_h):
+//   M qdd + N_h' H + J_h' Lambda_h Jdot_h qd - N_h' S_a' tau_a = N_h' J_c' f_c,
+// for the rows a selection S picks: S_f (the floating base) gives (8), S_a (the actuated joints) gives (9).
+// Each matrix holds the selected rows of the factor it names; the products with qdd, H, Lambda_h Jdot_h qd,
+// tau_a and f_c are the caller's, so that every caller keeps its own evaluation order. Allocation-free.
+template <int R>
+struct ProjectedDynamicsRows {
+  Eigen::Matrix<double, R, kNq> M;    // S M
+  Eigen::Matrix<double, R, kNq> NhT;  // S N_h' (rows of N_h' are columns of N_h)
+  Eigen::Matrix<double, R, kNh> JhT;  // S J_h'
+};
+template <int R>
+void projectedDynamicsRows(const ModelData& data, const ClosureProjection& proj, const std::array<int, R>& rows,
+                           ProjectedDynamicsRows<R>* out) {
+  for (int i = 0; i < R; ++i) {
+    const int j = rows[i];
+    out->M.row(i) = data.M.row(j);
+    out->NhT.row(i) = proj.N_h.col(j).transpose();
+    out->JhT.row(i) = data.Jh.col(j).transpose();
+  }
+}
+// The floating-base coordinates [x, z, pitch]: the selection S_f of (8).
+constexpr std::array<int, 3> kBaseIndex = {kBaseX, kBaseZ, kBasePitch};
 
 // Paper eq. 7 as an affine map of the QP's unknowns (qdd, f_c): the one place the actuated torque is computed.
 // The WBC bounds tau with these matrices and decodes its command from them, so the torque the QP limits and

@@ -10,20 +10,16 @@
 #include "model/robot_io.hpp"
 #include "wbc/wbc_config.hpp"
 #include "wbc/wbc_dynamics.hpp"
+#include "wbc/wbc_equations.hpp"
 #include "wbc/wbc_reference.hpp"
 #include "wbc/wbc_terms.hpp"
 
 namespace mft::wbc {
 
-// Paper (12): a coordinate dt ahead under constant acceleration, q + qd dt + qdd dt^2 / 2. The MFT rows (16e)
-// and the SA-WBC rows (20) use it with the unknown qdd taken out (qdd = 0: the qdd term is the rows' matrix),
-// the controller's diagnostics with the solved qdd.
-inline double predictedCoordinate(double q, double qd, double qdd, double dt) { return q + qd * dt + 0.5 * qdd * dt * dt; }
-
 // MFT preferable polytope in actuated joint space: A q_a <= b, q_a = [q4, q6, q8, q10] (paper: 12 x 4).
 struct WbcPolytope {
-  Eigen::Matrix<double, kNeps, model::kNa> A = Eigen::Matrix<double, kNeps, model::kNa>::Zero();
-  Eigen::Matrix<double, kNeps, 1> b = Eigen::Matrix<double, kNeps, 1>::Zero();
+  PolytopeMatrix A = PolytopeMatrix::Zero();
+  PolytopeVector b = PolytopeVector::Zero();
 };
 
 // Constants derived once from the robot, the config and the polytope.

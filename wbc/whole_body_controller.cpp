@@ -153,10 +153,7 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
 
     // The force-rate term needs a previous force: start from the weight shared by the stance feet.
     if (!have_fc_prev_) {
-      fc_prev_.setZero();
-      const int n_stance = static_cast<int>(ref.foot_in_stance[0]) + static_cast<int>(ref.foot_in_stance[1]);
-      for (int leg = 0; leg < model::kNumLegs; ++leg)
-        if (ref.foot_in_stance[leg]) fc_prev_[2 * leg + 1] = total_mass_ * model_.gravity / n_stance;
+      fc_prev_ = initialPreviousContactForce(total_mass_ * model_.gravity, ref.foot_in_stance);
       have_fc_prev_ = true;
     }
 

@@ -40,8 +40,9 @@ model::VectorC initialPreviousContactForce(double weight_N, const std::array<boo
 // Paper (15c), ||eps||^2: A = I (12 x 12), b = 0.
 void slackTaskRows(TaskMatrix* A, TaskVector* b);
 
-// Paper (8) = (16a), the floating-base rows of (7): S_f M qdd - S_f N_h' J_c' f_c = -S_f N_h' H (3 rows; the
-// J_h' term vanishes there). base_NhT = S_f N_h' (model::projectedDynamicsRows with model::kBaseIndex).
+// Paper (8) = (16a), the floating-base rows of (7): S_f M qdd - S_f N_h' J_c' f_c = -S_f N_h' H (3 rows). The
+// J_h' term is dropped: the closure gap is between two chains of one leg, which the base moves alike, so S_f J_h'
+// is zero (up to rounding). base_NhT = S_f N_h' (model::projectedDynamicsRows with model::kBaseIndex).
 void baseDynamicsRows(const model::MatrixQ& M, const model::VectorQ& H, const model::MatrixCQ& Jc,
                       const Eigen::Matrix<double, 3, model::kNq>& base_NhT, ConstraintMatrix* A, ConstraintVector* rhs);
 // The second block row of (6), the loop closure at acceleration level: J_h qdd = -Jdot_h qd (4 rows).

@@ -55,32 +55,15 @@ Task footTask(const char* name, int leg) {
   });
 }
 
-// (15b) and (15c): weight * || x_block - target ||^2 with an identity A (keeps the f_c / eps parts of H diagonal).
-Task contactForceTask(const WbcWeights& w) {
-  return Task("contact_force", VarBlock::Fc, kNfc, w.contact_force, [](const TickContext& c, Task* t) {
-    t->weight = c.params->weights.contact_force;
-    contactForceTaskRows(&t->A, &t->b);
+// A task whose weight is a WbcWeights member and whose rows come from one of the equation functions. Used for
+// (15b), (15c) and the qdd regularization: identity A, so the f_c / eps parts of H stay diagonal.
+using TaskRows = void (*)(const TickContext&, TaskMatrix*, TaskVector*);
+Task weightedTask(const char* name, VarBlock block, const WbcWeights& w, double WbcWeights::*weight_member,
+                  TaskRows rows) {
+  return Task(name, block, blockSize(block), w.*weight_member, [weight_member, rows](const TickContext& c, Task* t) {
+    t->weight = c.params->weights.*weight_member;
+    rows(c, &t->A, &t->b);
   });
-}
-Task contactForceRateTask(const WbcWeights& w) {
-  return Task("contact_force_rate", VarBlock::Fc, kNfc, w.contact_force_rate, [](const TickContext& c, Task* t) {
-    t->weight = c.params->weights.contact_force_rate;
-    contactForceRateTaskRows(c.fc_prev, &t->A, &t->b);
-  });
-}
-Task slackTask(const WbcWeights& w) {
-  return Task("slack", VarBlock::Eps, kNeps, w.slack, [](const TickContext& c, Task* t) {
-    t->weight = c.params->weights.slack;
-    slackTaskRows(&t->A, &t->b);
-  });
-}
-// Not in the paper: weight * ||qdd||^2.
-Task qddRegularizationTask(const WbcWeights& w) {
-  Task t("qdd_regularization", VarBlock::Qdd, kNqdd, w.qdd_regularization, [](const TickContext& c, Task* task) {
-    task->weight = c.params->weights.qdd_regularization;
-  });
-  t.A.setIdentity();
-  return t;
 }
 
 }  // namespace
@@ -130,15 +113,24 @@ Formulation buildFormulation(const WbcParams& params) {
   f.tasks.push_back(footTask("foot_right", model::kRightLeg));
   f.tasks.push_back(footTask("foot_left", model::kLeftLeg));
   // 15b: contact force regularization and rate penalty ||f_c - f_c^-||.
-  f.tasks.push_back(contactForceTask(w));
-  f.tasks.push_back(contactForceRateTask(w));
+  f.tasks.push_back(weightedTask("contact_force", VarBlock::Fc, w, &WbcWeights::contact_force,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) { contactForceTaskRows(A, b); }));
+  f.tasks.push_back(weightedTask("contact_force_rate", VarBlock::Fc, w, &WbcWeights::contact_force_rate,
+                                 [](const TickContext& c, TaskMatrix* A, TaskVector* b) {
+    contactForceRateTaskRows(c.fc_prev, A, b);
+  }));
   // 15c: slack of the MFT soft constraint (kept in every variant so H stays positive definite; eps is fixed
   // to 0 by its bounds when there is no MFT row).
-  f.tasks.push_back(slackTask(w));
+  f.tasks.push_back(weightedTask("slack", VarBlock::Eps, w, &WbcWeights::slack,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) { slackTaskRows(A, b); }));
   // Not in the paper: a small ||qdd||^2 term. The tasks above constrain only 6 of the 11 accelerations; the
   // rest would be fixed by the equalities alone, and the dual active-set solver needs H positive definite.
-  f.tasks.push_back(qddRegularizationTask(w));
-  // Not in the paper: base x while standing in double support (eq. 12 plans only z and pitch). Last, so the
+  f.tasks.push_back(weightedTask("qdd_regularization", VarBlock::Qdd, w, &WbcWeights::qdd_regularization,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) {
+    A->setIdentity(kNqdd, kNqdd);
+    b->setZero(kNqdd);
+  }));
+  // Not in the paper: base x while standing in double support ((18) plans only z and pitch). Last, so the
   // indices of the paper's terms stay as they were.
   f.tasks.push_back(baseXTask());
 

@@ -345,7 +345,7 @@ double potentialEnergy(const PlanarModel& model, const VectorQ& q) {
 
 void constrainedForwardDynamics(const ModelData& data, const VectorA& tau, const VectorC& f_c, VectorQ* qdd,
                                 VectorH* f_h) {
-  // Range-space (Schur complement) solution of the KKT system of eq. 1: M is SPD, so
+  // Range-space (Schur complement) solution of the KKT system of (6): M is SPD, so
   //   qdd = M^-1 (rhs + Jh' f_h),  (Jh M^-1 Jh') f_h = -Jdot_h qd - Jh M^-1 rhs.
   VectorQ rhs = data.Jc.transpose() * f_c - data.h;
   for (int i = 0; i < kNa; ++i) rhs(kActuatedIndex[i]) += tau(i);

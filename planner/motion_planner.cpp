@@ -83,7 +83,7 @@ void MotionPlanner::planSwing(const PlannerState& s, int swing_leg) {
   const OperatorCommand& cmd = gate_.current();
 
   if (!target_frozen_) {
-    // Eq. 13 with the LIP prediction of the pre-impact CoM state, relative to the support foot.
+    // (19) with the LIP prediction of the pre-impact CoM state, relative to the support foot.
     const double lambda = lipLambda(gravity_, s.com.y() - support.y());
     const double remaining = std::max(0.0, gait.step_duration_s - schedule_.timeInSwing());
     const LipState pre = lipPredict({s.com.x() - support.x(), s.com_vel.x()}, lambda, remaining);
@@ -111,7 +111,7 @@ void MotionPlanner::planSwing(const PlannerState& s, int swing_leg) {
     return;
   }
   // Late touchdown (e.g. a blind step down): the frozen target was planned for the nominal touchdown time while
-  // the base keeps moving as the foot looks for the ground. Eq. 13 from the CoM state now (the touchdown is due
+  // the base keeps moving as the foot looks for the ground. (19) from the CoM state now (the touchdown is due
   // now: no LIP prediction), and the foot moves toward it at most late_replan_speed_mps.
   const double lambda = lipLambda(gravity_, s.com.y() - support.y());
   const double v_avg = cmd.mode == LocomotionMode::Walk ? cmd.v_cmd : 0.0;

@@ -1,5 +1,5 @@
 #pragma once
-// The terms of Problem 1 (paper eq. 15-17, 10-11, 14): which tasks and constraints exist for a variant and
+// The terms of Problem 1 (paper (15)-(17), (11)-(14), (20)): which tasks and constraints exist for a variant and
 // how each is refreshed from the tick's state, reference and dynamics. This is the one place to add a term.
 #include <Eigen/Core>
 #include <vector>
@@ -25,7 +25,7 @@ struct WbcPolytope {
 // Constants derived once from the robot, the config and the polytope.
 struct WbcParams {
   WbcVariant variant = WbcVariant::Mft;
-  double dt = 0.05;  // prediction horizon of eq. 10-11 and eq. 14 [s]
+  double dt = 0.05;  // prediction horizon of (13)-(14) and (20) [s]
   WbcWeights weights;
   WbcGains gains;
   model::VectorA tau_max = model::VectorA::Zero();  // symmetric actuated torque limits [N m]
@@ -34,7 +34,7 @@ struct WbcParams {
   Eigen::Vector3d qdd_base_max{20.0, 20.0, 20.0};
   double qdd_joint_max = 22.0;
   WbcPolytope mft;
-  model::VectorA passive_lo = model::VectorA::Zero(), passive_hi = model::VectorA::Zero();  // eq. 14, S_ua order
+  model::VectorA passive_lo = model::VectorA::Zero(), passive_hi = model::VectorA::Zero();  // (20), S_ua order
 };
 // Throws std::invalid_argument if the variant needs a polytope and none is given, or it is not finite.
 WbcParams makeWbcParams(const model::RobotDescription& robot, const WbcConfig& config, const WbcPolytope* polytope);

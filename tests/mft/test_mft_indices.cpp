@@ -46,48 +46,56 @@ double maxPower(const Eigen::Vector2d& Q, const Twist& T) {
 
 const FiveBarGeometry kGeometries[] = {{0.0, 0.22, 0.26}, {0.06, 0.22, 0.26}, {0.0, 0.18, 0.33}, {0.04, 0.30, 0.25}};
 
-}  // namespace
-
-TEST(MftIndices, ClosedFormsMatchScrewTheory) {
-  std::mt19937 rng(11);
+// Calls check(geometry, pose) for `per_geometry` reachable random poses (hips in [-1.9, 1.9]) of every geometry.
+template <class Check>
+void forRandomPoses(unsigned seed, int per_geometry, Check&& check) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<double> q(-1.9, 1.9);
-  int checked = 0;
   for (const auto& g : kGeometries) {
-    for (int n = 0; n < 400;) {
+    for (int n = 0; n < per_geometry;) {
       FiveBarPose p;
       if (fiveBarForward(g, q(rng), q(rng), &p) != FiveBarStatus::Ok) continue;
       ++n;
-      const Eigen::Vector2d A[2] = {g.hipRear(), g.hipFore()};
-      const Eigen::Vector2d B[2] = {p.knee_point_rear, p.knee_point_fore};
-      const Eigen::Vector2d C = p.foot;
-      double lambda[2], eta[2];
-      for (int i = 0; i < 2; ++i) {
-        const int j = 1 - i;
-        // Transmission wrench of chain i: a pure force along the shank (two passive revolutes), through C.
-        const Wrench T = forceThrough(C, (C - B[i]).normalized());
-        const Twist in = rotationAbout(A[i]);   // input twist: the actuated hip
-        const Twist out = rotationAbout(B[j]);  // output twist: other hip locked, foot turns about knee j
-        // (2) in the library, from its own screw types, equals the oracle's reciprocal products.
-        const LimbPowers P = limbPowers(PlanarWrench::forceThrough(C, (C - B[i]).normalized()),
-                                        PlanarTwist::rotationAbout(A[i]), PlanarTwist::rotationAbout(B[j]));
-        EXPECT_NEAR(P.input, std::abs(reciprocal(T, in)), 1e-12);
-        EXPECT_NEAR(P.output, std::abs(reciprocal(T, out)), 1e-12);
-        lambda[i] = std::abs(reciprocal(T, in)) / maxPower(B[i], in);
-        eta[i] = std::abs(reciprocal(T, out)) / maxPower(C, out);
-      }
-      const TransmissionIndices t = transmissionIndices(p);
-      EXPECT_NEAR(t.iti_rear, lambda[0], 1e-9);
-      EXPECT_NEAR(t.iti_fore, lambda[1], 1e-9);
-      EXPECT_NEAR(eta[0], eta[1], 1e-9);  // the OTI is the same for both chains
-      EXPECT_NEAR(t.oti, std::min(eta[0], eta[1]), 1e-9);
-      EXPECT_NEAR(t.lti(), std::min({lambda[0], lambda[1], eta[0], eta[1]}), 1e-9);
-      // Generalized-coordinate form: |sin q5|, |sin q7|, |sin(q6 + q7 - q4 - q5)|.
-      EXPECT_NEAR(t.iti_rear, std::abs(std::sin(p.knee_rear)), 1e-12);
-      EXPECT_NEAR(t.iti_fore, std::abs(std::sin(p.knee_fore)), 1e-12);
-      EXPECT_NEAR(t.oti, std::abs(std::sin(p.q_fore + p.knee_fore - p.q_rear - p.knee_rear)), 1e-12);
-      ++checked;
+      check(g, p);
     }
   }
+}
+
+}  // namespace
+
+TEST(MftIndices, ClosedFormsMatchScrewTheory) {
+  int checked = 0;
+  forRandomPoses(11, 400, [&checked](const FiveBarGeometry& g, const FiveBarPose& p) {
+    const Eigen::Vector2d A[2] = {g.hipRear(), g.hipFore()};
+    const Eigen::Vector2d B[2] = {p.knee_point_rear, p.knee_point_fore};
+    const Eigen::Vector2d C = p.foot;
+    double lambda[2], eta[2];
+    for (int i = 0; i < 2; ++i) {
+      const int j = 1 - i;
+      // Transmission wrench of chain i: a pure force along the shank (two passive revolutes), through C.
+      const Wrench T = forceThrough(C, (C - B[i]).normalized());
+      const Twist in = rotationAbout(A[i]);   // input twist: the actuated hip
+      const Twist out = rotationAbout(B[j]);  // output twist: other hip locked, foot turns about knee j
+      // (2) in the library, from its own screw types, equals the oracle's reciprocal products.
+      const LimbPowers P = limbPowers(PlanarWrench::forceThrough(C, (C - B[i]).normalized()),
+                                      PlanarTwist::rotationAbout(A[i]), PlanarTwist::rotationAbout(B[j]));
+      EXPECT_NEAR(P.input, std::abs(reciprocal(T, in)), 1e-12);
+      EXPECT_NEAR(P.output, std::abs(reciprocal(T, out)), 1e-12);
+      lambda[i] = std::abs(reciprocal(T, in)) / maxPower(B[i], in);
+      eta[i] = std::abs(reciprocal(T, out)) / maxPower(C, out);
+    }
+    const TransmissionIndices t = transmissionIndices(p);
+    EXPECT_NEAR(t.iti_rear, lambda[0], 1e-9);
+    EXPECT_NEAR(t.iti_fore, lambda[1], 1e-9);
+    EXPECT_NEAR(eta[0], eta[1], 1e-9);  // the OTI is the same for both chains
+    EXPECT_NEAR(t.oti, std::min(eta[0], eta[1]), 1e-9);
+    EXPECT_NEAR(t.lti(), std::min({lambda[0], lambda[1], eta[0], eta[1]}), 1e-9);
+    // Generalized-coordinate form: |sin q5|, |sin q7|, |sin(q6 + q7 - q4 - q5)|.
+    EXPECT_NEAR(t.iti_rear, std::abs(std::sin(p.knee_rear)), 1e-12);
+    EXPECT_NEAR(t.iti_fore, std::abs(std::sin(p.knee_fore)), 1e-12);
+    EXPECT_NEAR(t.oti, std::abs(std::sin(p.q_fore + p.knee_fore - p.q_rear - p.knee_rear)), 1e-12);
+    ++checked;
+  });
   EXPECT_EQ(checked, 1600);
 }
 
@@ -156,25 +164,18 @@ TEST(MftIndices, ReciprocalProductIsThePowerAtThePointOfApplication) {
 // (2) on the five-bar leg at unit hip rate and unit shank force: P_I = l1 |sin knee_i| (the knee point moves at l1
 // perpendicular to the thigh) and P_O = l2 |u_r x u_f| (the foot turns about the other knee at distance l2).
 TEST(MftIndices, LimbPowersOfTheFiveBarMatchTheClosedForms) {
-  std::mt19937 rng(29);
-  std::uniform_real_distribution<double> q(-1.9, 1.9);
-  for (const auto& g : kGeometries) {
-    for (int n = 0; n < 200;) {
-      FiveBarPose p;
-      if (fiveBarForward(g, q(rng), q(rng), &p) != FiveBarStatus::Ok) continue;
-      ++n;
-      const Eigen::Vector2d A[2] = {g.hipRear(), g.hipFore()};
-      const Eigen::Vector2d B[2] = {p.knee_point_rear, p.knee_point_fore};
-      const double knee[2] = {p.knee_rear, p.knee_fore};
-      const double shank_between = p.q_fore + p.knee_fore - p.q_rear - p.knee_rear;
-      for (int i = 0; i < 2; ++i) {
-        const LimbPowers P = limbPowers(PlanarWrench::forceThrough(p.foot, (p.foot - B[i]).normalized()),
-                                        PlanarTwist::rotationAbout(A[i]), PlanarTwist::rotationAbout(B[1 - i]));
-        EXPECT_NEAR(P.input, g.l1 * std::abs(std::sin(knee[i])), 1e-12);
-        EXPECT_NEAR(P.output, g.l2 * std::abs(std::sin(shank_between)), 1e-12);
-      }
+  forRandomPoses(29, 200, [](const FiveBarGeometry& g, const FiveBarPose& p) {
+    const Eigen::Vector2d A[2] = {g.hipRear(), g.hipFore()};
+    const Eigen::Vector2d B[2] = {p.knee_point_rear, p.knee_point_fore};
+    const double knee[2] = {p.knee_rear, p.knee_fore};
+    const double shank_between = p.q_fore + p.knee_fore - p.q_rear - p.knee_rear;
+    for (int i = 0; i < 2; ++i) {
+      const LimbPowers P = limbPowers(PlanarWrench::forceThrough(p.foot, (p.foot - B[i]).normalized()),
+                                      PlanarTwist::rotationAbout(A[i]), PlanarTwist::rotationAbout(B[1 - i]));
+      EXPECT_NEAR(P.input, g.l1 * std::abs(std::sin(knee[i])), 1e-12);
+      EXPECT_NEAR(P.output, g.l2 * std::abs(std::sin(shank_between)), 1e-12);
     }
-  }
+  });
 }
 
 TEST(MftIndices, SingularConfigurationsGiveZeroNotNaN) {

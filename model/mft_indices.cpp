@@ -6,17 +6,39 @@
 namespace mft::model {
 
 namespace {
-// |sin| of the angle between two unit vectors, clamped so rounding never leaves [0, 1].
-double sinBetween(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return std::min(1.0, std::abs(cross2(a, b))); }
+// A planar direction turned by +90 degrees: the velocity direction of a point on a link of direction e that
+// turns about the link's other end.
+Eigen::Vector2d perpendicular(const Eigen::Vector2d& e) { return {-e.y(), e.x()}; }
 }  // namespace
+
+double transmissionAngleSine(const Eigen::Vector2d& f, const Eigen::Vector2d& v) {
+  const double scale = f.norm() * v.norm();
+  if (!(scale > 0.0)) return 0.0;
+  return std::min(1.0, std::abs(f.dot(v)) / scale);
+}
+
+PlanarTwist PlanarTwist::rotationAbout(const Eigen::Vector2d& c, double rate) {
+  // A point X moves with rate * perp(X - c); at the origin X = 0.
+  return {rate, rate * perpendicular(-c)};
+}
+
+PlanarWrench PlanarWrench::forceThrough(const Eigen::Vector2d& point, const Eigen::Vector2d& force) {
+  return {force, cross2(point, force)};
+}
+
+double reciprocalProduct(const PlanarWrench& W, const PlanarTwist& T) { return W.f.dot(T.v) + W.m * T.w; }
+
+LimbPowers limbPowers(const PlanarWrench& transmission, const PlanarTwist& input, const PlanarTwist& output) {
+  return {std::abs(reciprocalProduct(transmission, input)), std::abs(reciprocalProduct(transmission, output))};
+}
 
 TransmissionIndices transmissionIndices(const FiveBarPose& p) {
   const Eigen::Vector2d e_r = linkDirection(p.q_rear), e_f = linkDirection(p.q_fore);
   const Eigen::Vector2d u_r = linkDirection(p.shank_rear), u_f = linkDirection(p.shank_fore);
   TransmissionIndices t;
-  t.iti_rear = sinBetween(e_r, u_r);
-  t.iti_fore = sinBetween(e_f, u_f);
-  t.oti = sinBetween(u_r, u_f);
+  t.iti_rear = transmissionAngleSine(u_r, perpendicular(e_r));
+  t.iti_fore = transmissionAngleSine(u_f, perpendicular(e_f));
+  t.oti = transmissionAngleSine(u_r, perpendicular(u_f));
   return t;
 }
 

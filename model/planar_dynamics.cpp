@@ -345,7 +345,7 @@ double potentialEnergy(const PlanarModel& model, const VectorQ& q) {
 
 void constrainedForwardDynamics(const ModelData& data, const VectorA& tau, const VectorC& f_c, VectorQ* qdd,
                                 VectorH* f_h) {
-  // Range-space (Schur complement) solution of the KKT system of eq. 1: M is SPD, so
+  // Range-space (Schur complement) solution of the KKT system of (6): M is SPD, so
   //   qdd = M^-1 (rhs + Jh' f_h),  (Jh M^-1 Jh') f_h = -Jdot_h qd - Jh M^-1 rhs.
   VectorQ rhs = data.Jc.transpose() * f_c - data.h;
   for (int i = 0; i < kNa; ++i) rhs(kActuatedIndex[i]) += tau(i);
@@ -369,16 +369,13 @@ void closureProjection(const ModelData& data, ClosureProjection* out) {
 }
 
 bool actuatedTorqueMap(const ModelData& data, const ClosureProjection& proj, ActuatedTorqueMap* out) {
-  Eigen::Matrix<double, kNa, kNq> SaNhT;    // S_a N_h' (rows of N_h' are columns of N_h)
-  Eigen::Matrix<double, kNa, kNq> SaM;      // S_a M
-  Eigen::Matrix<double, kNa, kNh> SaJhT;    // S_a J_h'
+  // The actuated rows of (7): S_a M, S_a N_h', S_a J_h'.
+  ProjectedDynamicsRows<kNa> actuated;
+  projectedDynamicsRows<kNa>(data, proj, kActuatedIndex, &actuated);
+  const Eigen::Matrix<double, kNa, kNq>& SaNhT = actuated.NhT;
+  const Eigen::Matrix<double, kNa, kNq>& SaM = actuated.M;
+  const Eigen::Matrix<double, kNa, kNh>& SaJhT = actuated.JhT;
   Eigen::Matrix<double, kNa, kNa> SaNhTSaT;  // S_a N_h' S_a'
-  for (int i = 0; i < kNa; ++i) {
-    const int j = kActuatedIndex[i];
-    SaNhT.row(i) = proj.N_h.col(j).transpose();
-    SaM.row(i) = data.M.row(j);
-    SaJhT.row(i) = data.Jh.col(j).transpose();
-  }
   for (int k = 0; k < kNa; ++k) SaNhTSaT.col(k) = SaNhT.col(kActuatedIndex[k]);
   // 4x4 with a closed-form inverse in Eigen: no pivoting search, no allocation.
   const Eigen::Matrix<double, kNa, kNa> K = SaNhTSaT.inverse();

@@ -8,6 +8,7 @@
 // Body frames: a link's origin is its proximal joint and the link lies along its local -z axis, so a link at
 // absolute CCW angle a points along (sin a, -cos a). The torso frame is the base frame (origin on the hip axis).
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "model/coordinates.hpp"
@@ -96,12 +97,12 @@ Eigen::Vector3d bodyPose(const PlanarModel& model, const VectorQ& q, int body);
 double kineticEnergy(const ModelData& data, const VectorQ& qd);
 double potentialEnergy(const PlanarModel& model, const VectorQ& q);
 
-// Paper eq. 1: constrained forward dynamics with the loop closure. Given actuated torques and contact forces,
+// Paper (6): constrained forward dynamics with the loop closure. Given actuated torques and contact forces,
 // returns qdd and the closure forces f_h with  M qdd - Jh' f_h = S_a' tau + Jc' f_c - h,  Jh qdd = -Jdot_h qd.
 void constrainedForwardDynamics(const ModelData& data, const VectorA& tau, const VectorC& f_c, VectorQ* qdd,
                                 VectorH* f_h);
 
-// Paper eq. 2-7 helpers. Lambda_h = (Jh M^-1 Jh')^-1, N_h = I - M^-1 Jh' Lambda_h Jh.
+// Paper (7)-(9) helpers. Lambda_h = (Jh M^-1 Jh')^-1, N_h = I - M^-1 Jh' Lambda_h Jh.
 struct ClosureProjection {
   Eigen::Matrix<double, kNh, kNh> Lambda_h;
   MatrixQ N_h;
@@ -109,7 +110,31 @@ struct ClosureProjection {
 };
 void closureProjection(const ModelData& data, ClosureProjection* out);
 
-// Paper eq. 7 as an affine map of the QP's unknowns (qdd, f_c): the one place the actuated torque is computed.
+// Paper (7), the closure-projected equations of motion (f_h eliminated with N_h and Lambda_h):
+//   M qdd + N_h' H + J_h' Lambda_h Jdot_h qd - N_h' S_a' tau_a = N_h' J_c' f_c,
+// for the rows a selection S picks: S_f (the floating base) gives (8), S_a (the actuated joints) gives (9).
+// Each matrix holds the selected rows of the factor it names; the products with qdd, H, Lambda_h Jdot_h qd,
+// tau_a and f_c are the caller's, so that every caller keeps its own evaluation order. Allocation-free.
+template <int R>
+struct ProjectedDynamicsRows {
+  Eigen::Matrix<double, R, kNq> M;    // S M
+  Eigen::Matrix<double, R, kNq> NhT;  // S N_h' (rows of N_h' are columns of N_h)
+  Eigen::Matrix<double, R, kNh> JhT;  // S J_h'
+};
+template <int R>
+void projectedDynamicsRows(const ModelData& data, const ClosureProjection& proj, const std::array<int, R>& rows,
+                           ProjectedDynamicsRows<R>* out) {
+  for (int i = 0; i < R; ++i) {
+    const int j = rows[i];
+    out->M.row(i) = data.M.row(j);
+    out->NhT.row(i) = proj.N_h.col(j).transpose();
+    out->JhT.row(i) = data.Jh.col(j).transpose();
+  }
+}
+// The floating-base coordinates [x, z, pitch]: the selection S_f of (8).
+constexpr std::array<int, 3> kBaseIndex = {kBaseX, kBaseZ, kBasePitch};
+
+// Paper (9) as an affine map of the QP's unknowns (qdd, f_c): the one place the actuated torque is computed.
 // The WBC bounds tau with these matrices and decodes its command from them, so the torque the QP limits and
 // the torque the robot receives are the same numbers.
 //   tau_a = tau_qdd qdd + tau_fc f_c + tau_0,  K = (S_a N_h' S_a')^-1,
@@ -125,7 +150,7 @@ bool actuatedTorqueMap(const ModelData& data, const ClosureProjection& proj, Act
 // The map evaluated at (qdd, f_c).
 VectorA actuatedTorque(const ActuatedTorqueMap& map, const VectorQ& qdd, const VectorC& f_c);
 
-// Paper eq. 7 in one call: actuatedTorqueMap, then actuatedTorque. The velocity terms come from data (h and
+// Paper (9) in one call: actuatedTorqueMap, then actuatedTorque. The velocity terms come from data (h and
 // Jh_dot_qd of the last updateModel call), so qd must be the velocity data was updated with.
 VectorA inverseDynamicsActuated(const ModelData& data, const ClosureProjection& proj, const VectorQ& qdd,
                                 const VectorQ& qd, const VectorC& f_c);

@@ -1,5 +1,5 @@
 #pragma once
-// Eq. 13 and its inputs: the linear inverted pendulum (LIP) prediction of the pre-impact CoM state and the
+// Paper (19) and its inputs: the linear inverted pendulum (LIP) prediction of the pre-impact CoM state and the
 // desired pre-impact CoM speed of the H-LIP period-1 orbit for an average speed (Xiong & Ames 2019).
 #include "planner/planner_config.hpp"
 
@@ -21,7 +21,7 @@ LipState lipPredict(const LipState& now, double lambda, double t);
 // v- = sigma1 x-, sigma1 = lambda coth(lambda T_ssp / 2).
 double hlipPreImpactSpeed(double v_avg, double lambda, double T_ssp, double T_dsp);
 
-// Eq. 13: x_sw = x_C- + k_v xd_C- + k_p (xd_C- - xd_C-*), all world x; the offset x_sw - x_C- is clamped to
+// (19): x_sw = x_C- + k_v xd_C- + k_p (xd_C- - xd_C-*), all world x; the offset x_sw - x_C- is clamped to
 // +-max_offset_m so that the target stays within reach.
 double footPlacement(double x_com, double xd_com, double xd_des, const FootPlacementParams& p);
 

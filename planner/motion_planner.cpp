@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "planner/base_reference.hpp"
 #include "planner/foot_placement.hpp"
 #include "planner/swing_trajectory.hpp"
 
@@ -49,13 +50,12 @@ const PlanOutput& MotionPlanner::update(const PlannerState& s) {
   out_.swing_extended = schedule_.extended();
   out_.last_touchdown = schedule_.lastTouchdown();
 
-  // Eq. 12: z_ref = z_cmd (reached at a bounded rate), pitch_ref = 0.
-  const double max_step = config_.command.height_rate_mps * dt;
-  const double dz = std::clamp(cmd.z_cmd - z_ref_, -max_step, max_step);
-  z_ref_ += dz;
-  out_.base_z = {z_ref_, dt > 0.0 ? dz / dt : 0.0, 0.0};
-  out_.base_pitch.setZero();
-  // Standing: base x over the midpoint of the stance feet (a double-support task; the paper's eq. 12 plans only
+  // (18): z_ref = z_cmd (reached at a bounded rate), pitch_ref = 0.
+  const HeightPitchReference base = heightPitchReference(z_ref_, cmd.z_cmd, config_.command.height_rate_mps, dt);
+  z_ref_ = base.base_z[0];
+  out_.base_z = base.base_z;
+  out_.base_pitch = base.base_pitch;
+  // Standing: base x over the midpoint of the stance feet (a double-support task; the paper's (18) plans only
   // z and pitch, and with both feet down nothing else would stop the base drifting).
   out_.base_x = {0.5 * (hold_[0].x() + hold_[1].x()), 0.0, 0.0};
   out_.hold_base_x = cmd.mode == LocomotionMode::Stand && !schedule_.inSwing();
@@ -83,7 +83,7 @@ void MotionPlanner::planSwing(const PlannerState& s, int swing_leg) {
   const OperatorCommand& cmd = gate_.current();
 
   if (!target_frozen_) {
-    // Eq. 13 with the LIP prediction of the pre-impact CoM state, relative to the support foot.
+    // (19) with the LIP prediction of the pre-impact CoM state, relative to the support foot.
     const double lambda = lipLambda(gravity_, s.com.y() - support.y());
     const double remaining = std::max(0.0, gait.step_duration_s - schedule_.timeInSwing());
     const LipState pre = lipPredict({s.com.x() - support.x(), s.com_vel.x()}, lambda, remaining);
@@ -111,7 +111,7 @@ void MotionPlanner::planSwing(const PlannerState& s, int swing_leg) {
     return;
   }
   // Late touchdown (e.g. a blind step down): the frozen target was planned for the nominal touchdown time while
-  // the base keeps moving as the foot looks for the ground. Eq. 13 from the CoM state now (the touchdown is due
+  // the base keeps moving as the foot looks for the ground. (19) from the CoM state now (the touchdown is due
   // now: no LIP prediction), and the foot moves toward it at most late_replan_speed_mps.
   const double lambda = lipLambda(gravity_, s.com.y() - support.y());
   const double v_avg = cmd.mode == LocomotionMode::Walk ? cmd.v_cmd : 0.0;

@@ -1,12 +1,12 @@
 #pragma once
-// The paper's motion planner (section IV-A): eq. 12 for the base, support foot held at its touchdown position,
-// eq. 13 foot placement with the LIP-predicted pre-impact CoM state, cubic swing trajectory, contact schedule.
+// The paper's motion planner (section IV-A): (18) for the base, support foot held at its touchdown position,
+// (19) foot placement with the LIP-predicted pre-impact CoM state, cubic swing trajectory, contact schedule.
 // Per Remark 1 it re-plans only the swing foot; it does not react to other state changes.
 //
 // Additions to the paper, all configurable: the height reference is rate-limited toward the command (a step in
-// z_cmd would otherwise be a step in the reference), the eq. 13 target is frozen late in the swing, the
+// z_cmd would otherwise be a step in the reference), the (19) target is frozen late in the swing, the
 // offset of the target from the CoM is clamped to the legs' reach, and a late touchdown (the swing extended past
-// T looking for the ground) moves the foot toward eq. 13 re-planned from the current CoM state at a bounded speed.
+// T looking for the ground) moves the foot toward (19) re-planned from the current CoM state at a bounded speed.
 #include "model/robot_description.hpp"
 #include "planner/contact_schedule.hpp"
 #include "planner/operator_command.hpp"
@@ -57,7 +57,7 @@ class MotionPlanner {
   std::array<Eigen::Vector2d, model::kNumLegs> hold_{};  // support-foot positions (at touchdown)
   Eigen::Vector2d liftoff_{0, 0};
   bool target_frozen_ = false;
-  bool late_active_ = false;  // late touchdown: the swing foot follows eq. 13 re-planned from the current state
+  bool late_active_ = false;  // late touchdown: the swing foot follows (19) re-planned from the current state
   double late_x_ = 0.0;
   double tick_dt_ = 0.0;
   PlanOutput out_;

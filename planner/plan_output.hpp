@@ -29,15 +29,15 @@ struct PlanOutput {
   int stance_leg = -1;                // 0 right, 1 left, -1 both (double support / standing)
   bool swing_extended = false;        // the swing runs past its nominal duration (late touchdown)
   LocomotionMode mode = LocomotionMode::Stand;
-  Eigen::Vector3d base_z{0, 0, 0};      // eq. 12: [pos, vel, acc] of the base height
-  Eigen::Vector3d base_pitch{0, 0, 0};  // eq. 12: [pos, vel, acc] of the pitch (always 0)
+  Eigen::Vector3d base_z{0, 0, 0};      // (18): [pos, vel, acc] of the base height
+  Eigen::Vector3d base_pitch{0, 0, 0};  // (18): [pos, vel, acc] of the pitch (always 0)
   // Not in the paper (it leaves base x passive, stepping stabilises it): standing in double support, the base x
   // is held at the midpoint of the two stance feet. base_x is always filled; hold_base_x says when it applies.
   Eigen::Vector3d base_x{0, 0, 0};      // [pos, vel, acc] of the base (hip axis) x
   bool hold_base_x = false;             // Stand mode and both feet in stance
   std::array<FootReference, model::kNumLegs> foot{};
 
-  // Eq. 13 diagnostics of the current swing (zero when standing).
+  // (19) diagnostics of the current swing (zero when standing).
   double target_x = 0.0;              // planned pre-impact swing-foot x
   Eigen::Vector2d predicted_com{0, 0};  // predicted pre-impact CoM [x, xdot]
   double desired_com_speed = 0.0;     // desired pre-impact CoM speed

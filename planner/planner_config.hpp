@@ -18,13 +18,13 @@ struct GaitParams {
 struct SwingParams {
   double lift_height_m = 0.06;       // apex above the ground height, at mid-swing
   double touchdown_speed_mps = 0.2;  // downward speed at the end of the nominal swing, kept while extended
-  double replan_until_phase = 0.8;   // eq. 13 is re-evaluated every tick until this phase, then frozen
-  double late_replan_speed_mps = 1.0;  // late touchdown: the foot moves toward eq. 13 re-planned now (0 = frozen)
+  double replan_until_phase = 0.8;   // (19) is re-evaluated every tick until this phase, then frozen
+  double late_replan_speed_mps = 1.0;  // late touchdown: the foot moves toward (19) re-planned now (0 = frozen)
 };
 
 struct FootPlacementParams {
-  double k_v = 0.16;           // eq. 13 [s]
-  double k_p = 0.08;           // eq. 13 [s]
+  double k_v = 0.16;           // (19) [s]
+  double k_p = 0.08;           // (19) [s]
   double max_offset_m = 0.25;  // |target - predicted pre-impact CoM x| is clamped to this (leg reach)
 };
 

@@ -15,7 +15,7 @@ PosVelAcc cubicHermite(double p0, double v0, double p1, double v1, double T, dou
 
 struct SwingSpec {
   Eigen::Vector2d liftoff{0, 0};    // world [x, z] at lift-off
-  double target_x = 0.0;            // pre-impact x (eq. 13)
+  double target_x = 0.0;            // pre-impact x (19)
   double ground_z = 0.0;            // height to land at
   double duration_s = 0.35;         // nominal swing duration
   double lift_height_m = 0.06;      // apex = max(liftoff z, ground_z) + lift height

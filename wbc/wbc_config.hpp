@@ -1,6 +1,6 @@
 #pragma once
-// Controller parameters (config/wbc.yaml): variant, task weights (paper Table I), PD gains (eq. 17), limits,
-// contact model, SA-WBC passive-joint bounds (eq. 14) and the safety stage. The defaults of this struct are
+// Controller parameters (config/wbc.yaml): variant, task weights (paper Table I), PD gains (17), limits,
+// contact model, SA-WBC passive-joint bounds (20) and the safety stage. The defaults of this struct are
 // the values of the shipped config/wbc.yaml, so tests can build a controller without a file.
 #include <Eigen/Core>
 #include <string>
@@ -11,7 +11,7 @@ namespace mft::wbc {
 
 // Which Problem 1 is solved (one code path, rows and bounds switched at construction):
 //   Mft  - the paper: soft MFT polytope C qdd <= d + eps, eps weighted by w_eps.
-//   Sa   - SA-WBC baseline: no MFT rows, eps fixed to 0 by bounds, passive-joint bound of eq. 14.
+//   Sa   - SA-WBC baseline: no MFT rows, eps fixed to 0 by bounds, passive-joint bound of (20).
 //   None - neither (ablation).
 enum class WbcVariant { Mft, Sa, None };
 const char* toString(WbcVariant v);
@@ -61,7 +61,7 @@ struct WbcContact {
   double normal_force_max_N = 1000.0;  // f_z upper bound of a stance foot (a swing foot gets 0)
 };
 
-struct WbcSaBounds {  // eq. 14 singularity boundaries of the passive knees (with the robot's sign per knee)
+struct WbcSaBounds {  // (20): singularity boundaries of the passive knees (with the robot's sign per knee)
   model::Interval rear_knee_rad{0.0, 3.141592653589793};    // q5, q9: the singularities 0 and pi
   model::Interval fore_knee_rad{-3.141592653589793, 0.0};   // q7, q11: the singularities -pi and 0
 };

@@ -36,7 +36,7 @@ struct WbcDiagnostics {
   // solution (<= 0 inside). NaN without a polytope.
   double mft_violation = std::numeric_limits<double>::quiet_NaN();
   double mft_violation_predicted = std::numeric_limits<double>::quiet_NaN();
-  bool torque_clamped = false;  // the eq. 7 torques exceeded the limits by more than the solver tolerance
+  bool torque_clamped = false;  // the (9) torques exceeded the limits by more than the solver tolerance
   // Solution of the tick (zeros when no solution was used).
   model::VectorQ qdd = model::VectorQ::Zero();
   model::VectorC f_c = model::VectorC::Zero();

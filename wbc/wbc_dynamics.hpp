@@ -1,6 +1,6 @@
 #pragma once
 // Per-tick dynamics terms of Problem 1 that several rows share: the floating-base rows of the closure-
-// projected dynamics (paper eq. 3 / 16a) and the actuated torque as an affine map of (qdd, f_c) (paper eq. 7,
+// projected dynamics (paper (8) = (16a)) and the actuated torque as an affine map of (qdd, f_c) (paper (9),
 // model::actuatedTorqueMap). The QP's torque rows and the decoded command both read `torque`.
 #include <Eigen/Core>
 

@@ -1,8 +1,5 @@
 #include "wbc/wbc_formulation.hpp"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
 #include <stdexcept>
 
 #include "model/config/enum_names.hpp"
@@ -10,25 +7,20 @@
 namespace mft::wbc {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 using model::kNa;
 using model::kNq;
 
-// Eq. 17 for one coordinate.
-double pdAcceleration(const Setpoint1& ref, double pos, double vel, const PdGains1& g) {
-  return ref.acc + g.kp * (ref.pos - pos) + g.kd * (ref.vel - vel);
-}
-
-// Floating-base coordinate task (height or pitch): J = unit row, Jdot qd = 0. Weights and gains are read from
+// Floating-base coordinate task (height or pitch), (15a) with the PD law (17). Weights and gains are read from
 // the parameters at every tick, so a live change (WholeBodyController::setTuning) acts from the next tick.
 Task baseCoordinateTask(const char* name, int index, const WbcWeights& w, double WbcWeights::*weight_member,
                         const Setpoint1 WbcReference::*ref_member, const PdGains1 WbcGains::*gains_member) {
   return Task(name, VarBlock::Qdd, 1, w.*weight_member,
               [index, weight_member, ref_member, gains_member](const TickContext& c, Task* t) {
     t->weight = c.params->weights.*weight_member;
-    t->A.setZero();
-    t->A(0, index) = 1.0;
-    t->b(0) = pdAcceleration(c.ref->*ref_member, c.state->q[index], c.state->qd[index], c.params->gains.*gains_member);
+    coordinateTaskRows(index,
+                       pdAcceleration(c.ref->*ref_member, c.state->q[index], c.state->qd[index],
+                                      c.params->gains.*gains_member),
+                       &t->A, &t->b);
   });
 }
 
@@ -38,15 +30,15 @@ Task baseXTask() {
   return Task("base_x", VarBlock::Qdd, 1, 0.0, [](const TickContext& c, Task* t) {
     const bool active = c.ref->hold_base_x && c.ref->foot_in_stance[0] && c.ref->foot_in_stance[1];
     t->weight = active ? c.params->weights.base_x : 0.0;
-    t->A.setZero();
-    t->A(0, model::kBaseX) = 1.0;
-    t->b(0) = active ? pdAcceleration(c.ref->base_x, c.state->q[model::kBaseX], c.state->qd[model::kBaseX],
-                                      c.params->gains.base_x)
-                     : 0.0;
+    coordinateTaskRows(model::kBaseX,
+                       active ? pdAcceleration(c.ref->base_x, c.state->q[model::kBaseX],
+                                               c.state->qd[model::kBaseX], c.params->gains.base_x)
+                              : 0.0,
+                       &t->A, &t->b);
   });
 }
 
-// Foot point task: J_c rows of the foot; swing or support weight and gains from the contact schedule.
+// Foot point task, (15a) with (17) per axis: swing or support weight and gains from the contact schedule.
 Task footTask(const char* name, int leg) {
   return Task(name, VarBlock::Qdd, 2, 0.0, [leg](const TickContext& c, Task* t) {
     const bool stance = c.ref->foot_in_stance[leg];
@@ -54,24 +46,24 @@ Task footTask(const char* name, int leg) {
     const PdGains2& g = stance ? p.gains.support_foot : p.gains.swing_foot;
     t->weight = stance ? p.weights.support_foot : p.weights.swing_foot;
     const int r = 2 * leg;
-    t->A = c.model->Jc.middleRows<2>(r);
+    Eigen::Vector2d xdd_des;
     for (int i = 0; i < 2; ++i) {
       const Setpoint1 ref{c.ref->foot_pos[r + i], c.ref->foot_vel[r + i], c.ref->foot_acc[r + i]};
-      const double xdd_des = pdAcceleration(ref, c.model->foot_pos[r + i], c.model->foot_vel[r + i], {g.kp[i], g.kd[i]});
-      t->b(i) = xdd_des - c.model->Jc_dot_qd[r + i];
+      xdd_des[i] = pdAcceleration(ref, c.model->foot_pos[r + i], c.model->foot_vel[r + i], {g.kp[i], g.kd[i]});
     }
+    footTaskRows(c.model->Jc, c.model->Jc_dot_qd, leg, xdd_des, &t->A, &t->b);
   });
 }
 
-// weight * || x_block - target ||^2 with an identity A (keeps the f_c / eps parts of H diagonal).
-Task identityTask(const char* name, VarBlock block, const WbcWeights& w, double WbcWeights::*weight_member,
-                  bool track_fc_prev) {
-  Task t(name, block, blockSize(block), w.*weight_member, [weight_member, track_fc_prev](const TickContext& c, Task* task) {
-    task->weight = c.params->weights.*weight_member;
-    if (track_fc_prev) task->b = c.fc_prev;
+// A task whose weight is a WbcWeights member and whose rows come from one of the equation functions. Used for
+// (15b), (15c) and the qdd regularization: identity A, so the f_c / eps parts of H stay diagonal.
+using TaskRows = void (*)(const TickContext&, TaskMatrix*, TaskVector*);
+Task weightedTask(const char* name, VarBlock block, const WbcWeights& w, double WbcWeights::*weight_member,
+                  TaskRows rows) {
+  return Task(name, block, blockSize(block), w.*weight_member, [weight_member, rows](const TickContext& c, Task* t) {
+    t->weight = c.params->weights.*weight_member;
+    rows(c, &t->A, &t->b);
   });
-  t.A.setIdentity();
-  return t;
 }
 
 }  // namespace
@@ -113,88 +105,66 @@ Formulation buildFormulation(const WbcParams& params) {
   Formulation f;
   const WbcWeights& w = params.weights;
 
-  // --- Cost, eq. 15 ---
-  // 15a: operational-space tracking through the PD law of eq. 17.
+  // --- Cost, (15) ---
+  // 15a: operational-space tracking through the PD law of (17).
   f.tasks.push_back(baseCoordinateTask("base_z", model::kBaseZ, w, &WbcWeights::base_z, &WbcReference::base_z, &WbcGains::base_z));
   f.tasks.push_back(
       baseCoordinateTask("base_pitch", model::kBasePitch, w, &WbcWeights::base_pitch, &WbcReference::base_pitch, &WbcGains::base_pitch));
   f.tasks.push_back(footTask("foot_right", model::kRightLeg));
   f.tasks.push_back(footTask("foot_left", model::kLeftLeg));
   // 15b: contact force regularization and rate penalty ||f_c - f_c^-||.
-  f.tasks.push_back(identityTask("contact_force", VarBlock::Fc, w, &WbcWeights::contact_force, false));
-  f.tasks.push_back(identityTask("contact_force_rate", VarBlock::Fc, w, &WbcWeights::contact_force_rate, true));
+  f.tasks.push_back(weightedTask("contact_force", VarBlock::Fc, w, &WbcWeights::contact_force,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) { contactForceTaskRows(A, b); }));
+  f.tasks.push_back(weightedTask("contact_force_rate", VarBlock::Fc, w, &WbcWeights::contact_force_rate,
+                                 [](const TickContext& c, TaskMatrix* A, TaskVector* b) {
+    contactForceRateTaskRows(c.fc_prev, A, b);
+  }));
   // 15c: slack of the MFT soft constraint (kept in every variant so H stays positive definite; eps is fixed
   // to 0 by its bounds when there is no MFT row).
-  f.tasks.push_back(identityTask("slack", VarBlock::Eps, w, &WbcWeights::slack, false));
+  f.tasks.push_back(weightedTask("slack", VarBlock::Eps, w, &WbcWeights::slack,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) { slackTaskRows(A, b); }));
   // Not in the paper: a small ||qdd||^2 term. The tasks above constrain only 6 of the 11 accelerations; the
   // rest would be fixed by the equalities alone, and the dual active-set solver needs H positive definite.
-  f.tasks.push_back(identityTask("qdd_regularization", VarBlock::Qdd, w, &WbcWeights::qdd_regularization, false));
-  // Not in the paper: base x while standing in double support (eq. 12 plans only z and pitch). Last, so the
+  f.tasks.push_back(weightedTask("qdd_regularization", VarBlock::Qdd, w, &WbcWeights::qdd_regularization,
+                                 [](const TickContext&, TaskMatrix* A, TaskVector* b) {
+    A->setIdentity(kNqdd, kNqdd);
+    b->setZero(kNqdd);
+  }));
+  // Not in the paper: base x while standing in double support ((18) plans only z and pitch). Last, so the
   // indices of the paper's terms stay as they were.
   f.tasks.push_back(baseXTask());
 
-  // --- Constraints, eq. 16 and the loop closure ---
+  // --- Constraints, (16) and the loop closure ---
   using Type = Constraint::Type;
-  // 16a: S_f (M qdd + N_h' h) = S_f N_h' J_c' f_c.
+  // (8) = (16a): S_f (M qdd + N_h' H) = S_f N_h' J_c' f_c.
   f.constraints.emplace_back("eq_base_dyn", Type::Equality, 3, [](const TickContext& c, Constraint* k) {
-    k->A.block<3, kNqdd>(0, 0) = c.model->M.topRows<3>();
-    k->A.block<3, kNfc>(0, kNqdd).noalias() = -c.dyn->base_NhT * c.model->Jc.transpose();
-    k->lower.noalias() = -c.dyn->base_NhT * c.model->h;
+    baseDynamicsRows(c.model->M, c.model->h, c.model->Jc, c.dyn->base_NhT, &k->A, &k->lower);
   });
-  // Loop closure J_h qdd = -Jdot_h qd (the second row of eq. 1).
+  // Loop closure J_h qdd = -Jdot_h qd (the second block row of (6)).
   f.constraints.emplace_back("eq_closure", Type::Equality, model::kNh, [](const TickContext& c, Constraint* k) {
-    k->A.block<model::kNh, kNqdd>(0, 0) = c.model->Jh;
-    k->lower = -c.model->Jh_dot_qd;
+    loopClosureRows(c.model->Jh, c.model->Jh_dot_qd, &k->A, &k->lower);
   });
-  // 16b: friction pyramid U f_c <= 0: +-f_x - mu f_z <= 0 per foot (f_z >= 0 is a bound).
+  // (16b): friction pyramid U f_c <= 0 (f_z >= 0 is a bound).
   f.constraints.emplace_back("in_friction", Type::Inequality, 4, [](const TickContext& c, Constraint* k) {
-    for (int foot = 0; foot < 2; ++foot) {
-      for (int s = 0; s < 2; ++s) {
-        const int r = 2 * foot + s;
-        k->A(r, kNqdd + 2 * foot) = s == 0 ? 1.0 : -1.0;
-        k->A(r, kNqdd + 2 * foot + 1) = -c.params->mu;
-        k->lower(r) = -kInf;
-        k->upper(r) = 0.0;
-      }
-    }
+    frictionPyramidRows(c.params->mu, &k->A, &k->lower, &k->upper);
   });
-  // 16c: tau_min <= tau_a(qdd, f_c) <= tau_max through the affine map of eq. 7.
+  // (16c): tau_min <= tau_a(qdd, f_c) <= tau_max through the affine map of (9).
   f.constraints.emplace_back("in_torque", Type::Inequality, kNa, [](const TickContext& c, Constraint* k) {
-    k->A.block<kNa, kNqdd>(0, 0) = c.dyn->torque.tau_qdd;
-    k->A.block<kNa, kNfc>(0, kNqdd) = c.dyn->torque.tau_fc;
-    k->lower = -c.params->tau_max - c.dyn->torque.tau_0;
-    k->upper = c.params->tau_max - c.dyn->torque.tau_0;
+    torqueLimitRows(c.dyn->torque, c.params->tau_max, &k->A, &k->lower, &k->upper);
   });
-  // 16e with eq. 10-11 (J = S_a, Jdot qd = 0): C qdd - eps <= d, C = dt^2/2 A S_a, d = b - A (q_a + qd_a dt).
+  // (16e) = (11) with (13)-(14): C qdd - eps <= d.
   if (params.variant == WbcVariant::Mft) {
     f.constraints.emplace_back("in_mft", Type::Inequality, kNeps, [](const TickContext& c, Constraint* k) {
       const WbcParams& p = *c.params;
-      model::VectorA qa_pred;
-      for (int i = 0; i < kNa; ++i) {
-        const int j = model::kActuatedIndex[i];
-        qa_pred[i] = predictedCoordinate(c.state->q[j], c.state->qd[j], 0.0, p.dt);
-        k->A.col(j) = 0.5 * p.dt * p.dt * p.mft.A.col(i);
-      }
-      k->A.block<kNeps, kNeps>(0, kNqdd + kNfc) = -Eigen::Matrix<double, kNeps, kNeps>::Identity();
-      k->lower.setConstant(-kInf);
-      k->upper.noalias() = p.mft.b - p.mft.A * qa_pred;
+      mftPolytopeRows(p.mft.A, p.mft.b, c.state->q, c.state->qd, p.dt, &k->A, &k->lower, &k->upper);
     });
   }
-  // Eq. 14 (SA-WBC): q_ua_min <= S_ua (q + qd dt + qdd dt^2 / 2) <= q_ua_max.
+  // (20) (SA-WBC): q_ua_min <= S_ua (q + qd dt + qdd dt^2 / 2) <= q_ua_max, clipped to the qdd box's reach.
   if (params.variant == WbcVariant::Sa) {
     f.constraints.emplace_back("in_passive", Type::Inequality, kNa, [](const TickContext& c, Constraint* k) {
       const WbcParams& p = *c.params;
-      const double s = 0.5 * p.dt * p.dt;
-      // What the qdd box can change in dt: a row needing more is clipped to it, so an estimate already past a
-      // boundary asks for the strongest correction instead of making the QP infeasible.
-      const double reach = s * p.qdd_joint_max;
-      for (int i = 0; i < kNa; ++i) {
-        const int j = model::kPassiveIndex[i];
-        const double nominal = predictedCoordinate(c.state->q[j], c.state->qd[j], 0.0, p.dt);
-        k->A(i, j) = s;
-        k->lower(i) = std::min(p.passive_lo[i] - nominal, reach);
-        k->upper(i) = std::max(p.passive_hi[i] - nominal, -reach);
-      }
+      passiveJointRows(c.state->q, c.state->qd, p.dt, p.passive_lo, p.passive_hi, p.qdd_joint_max, &k->A, &k->lower,
+                       &k->upper);
     });
   }
 
@@ -213,21 +183,9 @@ Formulation buildFormulation(const WbcParams& params) {
 
 void updateBounds(const TickContext& ctx, VariableBounds* bounds) {
   const WbcParams& p = *ctx.params;
-  for (int i = 0; i < kNqdd; ++i) {
-    const double m = i < 3 ? p.qdd_base_max[i] : p.qdd_joint_max;
-    bounds->lb[i] = -m;
-    bounds->ub[i] = m;
-  }
-  for (int foot = 0; foot < 2; ++foot) {
-    const int ix = kNqdd + 2 * foot;
-    bounds->lb[ix] = -kInf;  // f_x: limited by the pyramid
-    bounds->ub[ix] = kInf;
-    bounds->lb[ix + 1] = 0.0;
-    bounds->ub[ix + 1] = ctx.ref->foot_in_stance[foot] ? p.fz_max : 0.0;
-  }
-  const bool soft_mft = p.variant == WbcVariant::Mft;
-  bounds->lb.tail<kNeps>().setConstant(soft_mft ? -kInf : 0.0);
-  bounds->ub.tail<kNeps>().setConstant(soft_mft ? kInf : 0.0);
+  accelerationBounds(p.qdd_base_max, p.qdd_joint_max, bounds);  // (16d)
+  contactForceBounds(ctx.ref->foot_in_stance, p.fz_max, bounds);  // (16b), f_z
+  slackBounds(p.variant == WbcVariant::Mft, bounds);              // (16e), eps
 }
 
 int findTask(const Formulation& f, const std::string& name) {

@@ -1,5 +1,5 @@
 #pragma once
-// The terms of Problem 1 (paper eq. 15-17, 10-11, 14): which tasks and constraints exist for a variant and
+// The terms of Problem 1 (paper (15)-(17), (11)-(14), (20)): which tasks and constraints exist for a variant and
 // how each is refreshed from the tick's state, reference and dynamics. This is the one place to add a term.
 #include <Eigen/Core>
 #include <vector>
@@ -10,26 +10,22 @@
 #include "model/robot_io.hpp"
 #include "wbc/wbc_config.hpp"
 #include "wbc/wbc_dynamics.hpp"
+#include "wbc/wbc_equations.hpp"
 #include "wbc/wbc_reference.hpp"
 #include "wbc/wbc_terms.hpp"
 
 namespace mft::wbc {
 
-// Paper (12): a coordinate dt ahead under constant acceleration, q + qd dt + qdd dt^2 / 2. The MFT rows (16e)
-// and the SA-WBC rows (20) use it with the unknown qdd taken out (qdd = 0: the qdd term is the rows' matrix),
-// the controller's diagnostics with the solved qdd.
-inline double predictedCoordinate(double q, double qd, double qdd, double dt) { return q + qd * dt + 0.5 * qdd * dt * dt; }
-
 // MFT preferable polytope in actuated joint space: A q_a <= b, q_a = [q4, q6, q8, q10] (paper: 12 x 4).
 struct WbcPolytope {
-  Eigen::Matrix<double, kNeps, model::kNa> A = Eigen::Matrix<double, kNeps, model::kNa>::Zero();
-  Eigen::Matrix<double, kNeps, 1> b = Eigen::Matrix<double, kNeps, 1>::Zero();
+  PolytopeMatrix A = PolytopeMatrix::Zero();
+  PolytopeVector b = PolytopeVector::Zero();
 };
 
 // Constants derived once from the robot, the config and the polytope.
 struct WbcParams {
   WbcVariant variant = WbcVariant::Mft;
-  double dt = 0.05;  // prediction horizon of eq. 10-11 and eq. 14 [s]
+  double dt = 0.05;  // prediction horizon of (13)-(14) and (20) [s]
   WbcWeights weights;
   WbcGains gains;
   model::VectorA tau_max = model::VectorA::Zero();  // symmetric actuated torque limits [N m]
@@ -38,7 +34,7 @@ struct WbcParams {
   Eigen::Vector3d qdd_base_max{20.0, 20.0, 20.0};
   double qdd_joint_max = 22.0;
   WbcPolytope mft;
-  model::VectorA passive_lo = model::VectorA::Zero(), passive_hi = model::VectorA::Zero();  // eq. 14, S_ua order
+  model::VectorA passive_lo = model::VectorA::Zero(), passive_hi = model::VectorA::Zero();  // (20), S_ua order
 };
 // Throws std::invalid_argument if the variant needs a polytope and none is given, or it is not finite.
 WbcParams makeWbcParams(const model::RobotDescription& robot, const WbcConfig& config, const WbcPolytope* polytope);

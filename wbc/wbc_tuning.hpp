@@ -12,7 +12,7 @@
 
 namespace mft::wbc {
 
-// What a live change may touch: the cost weights (eq. 15) and the PD gains (eq. 17).
+// What a live change may touch: the cost weights (15) and the PD gains (17).
 struct WbcTuning {
   WbcWeights weights;
   WbcGains gains;

@@ -142,7 +142,7 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
       return finish(fail(SafetyEvent::NonFiniteInput, state, diag));
     }
 
-    // Model update: M, h, J_c, J_h and their Jdot qd, then the closure projection of eq. 2-7.
+    // Model update: M, h, J_c, J_h and their Jdot qd, then the closure projection of (7)-(9).
     model::updateModel(model_, state.q, state.qd, &data_);
     model::closureProjection(data_, &proj_);
     if (!modelFinite(data_) || !computeDynamicsTerms(data_, proj_, &dyn_)) {
@@ -153,10 +153,7 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
 
     // The force-rate term needs a previous force: start from the weight shared by the stance feet.
     if (!have_fc_prev_) {
-      fc_prev_.setZero();
-      const int n_stance = static_cast<int>(ref.foot_in_stance[0]) + static_cast<int>(ref.foot_in_stance[1]);
-      for (int leg = 0; leg < model::kNumLegs; ++leg)
-        if (ref.foot_in_stance[leg]) fc_prev_[2 * leg + 1] = total_mass_ * model_.gravity / n_stance;
+      fc_prev_ = initialPreviousContactForce(total_mass_ * model_.gravity, ref.foot_in_stance);
       have_fc_prev_ = true;
     }
 
@@ -201,7 +198,7 @@ model::ActuatorCommand WholeBodyController::update(const model::RobotStateEstima
       diag->mft_violation_predicted = polytopeViolation(q_pred);
     }
 
-    // Eq. 7 decoded from the same matrices the QP's torque rows used, then the actuator limits (the QP keeps
+    // (9) decoded from the same matrices the QP's torque rows used, then the actuator limits (the QP keeps
     // tau inside them up to its tolerance).
     model::VectorA tau = model::actuatedTorque(dyn_.torque, qdd, f_c);
     if (!tau.allFinite()) return finish(fail(SafetyEvent::NonFiniteOutput, state, diag));

@@ -1,6 +1,6 @@
 #pragma once
-// The MFT-WBC of the paper (Problem 1, eq. 15-17) with the SA-WBC baseline (eq. 14) and a no-MFT ablation,
-// torques by the closed-loop inverse dynamics (eq. 7), and a safety stage. One update() per control tick;
+// The MFT-WBC of the paper (Problem 1, (15)-(17)) with the SA-WBC baseline (20) and a no-MFT ablation,
+// torques by the closed-loop inverse dynamics (9), and a safety stage. One update() per control tick;
 // everything is sized at construction and nothing is allocated per tick.
 //
 //   const MftPolytope polytope = model::loadMftPolytope("config/mft_space.yaml", robot);

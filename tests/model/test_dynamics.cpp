@@ -520,6 +520,51 @@ TEST(DynamicsConstrained, InverseDynamicsRecoversTheTorquesOfForwardDynamics) {
   });
 }
 
+// Paper (7) as projectedDynamicsRows gives it, for all 11 rows and for the S_f / S_a selections (8), (9) use:
+// the rows equal N_h' built here from a pivoted-LU inverse of M and of J_h M^-1 J_h' (not closureProjection's
+// Cholesky), and (7) holds on the qdd and f_h-free solution of the Schur-complement forward dynamics (6).
+TEST(DynamicsConstrained, ProjectedDynamicsRowsAreEquationSevenOnForwardDynamicsSolutions) {
+  std::mt19937 rng(31);
+  const MatrixAQ Sa = actuationSelector();
+  constexpr std::array<int, kNq> kAll = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  forRandomLoadedStates(rng, 100, [&Sa, &kAll](int k, LoadedState& s, const ModelData& data) {
+    if (k % 4 == 0) s.f_c.setZero();  // flight phase
+    VectorQ qdd;
+    constrainedForwardDynamics(data, s.tau, s.f_c, &qdd, nullptr);
+    ClosureProjection proj;
+    closureProjection(data, &proj);
+    ProjectedDynamicsRows<kNq> all;
+    projectedDynamicsRows<kNq>(data, proj, kAll, &all);
+
+    const MatrixQ Minv = data.M.partialPivLu().inverse();
+    const Eigen::Matrix<double, kNh, kNh> Lambda = (data.Jh * Minv * data.Jh.transpose()).partialPivLu().inverse();
+    const MatrixQ NhT = MatrixQ::Identity() - data.Jh.transpose() * Lambda * data.Jh * Minv;
+    EXPECT_LT((all.NhT - NhT).cwiseAbs().maxCoeff(), 1e-9);
+    EXPECT_EQ(all.M, data.M);
+    EXPECT_EQ(all.JhT, data.Jh.transpose());
+
+    const VectorQ residual = all.M * qdd + all.NhT * data.h + all.JhT * (Lambda * data.Jh_dot_qd) -
+                             all.NhT * Sa.transpose() * s.tau - all.NhT * data.Jc.transpose() * s.f_c;
+    const double scale = 1.0 + (data.M * qdd).cwiseAbs().maxCoeff() + data.h.cwiseAbs().maxCoeff();
+    EXPECT_LT(residual.cwiseAbs().maxCoeff(), 1e-10 * scale) << residual.transpose();
+
+    // The selections are the same rows.
+    ProjectedDynamicsRows<3> base;
+    projectedDynamicsRows<3>(data, proj, kBaseIndex, &base);
+    ProjectedDynamicsRows<kNa> actuated;
+    projectedDynamicsRows<kNa>(data, proj, kActuatedIndex, &actuated);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(base.NhT.row(i), all.NhT.row(kBaseIndex[i]));
+    for (int i = 0; i < kNa; ++i) {
+      EXPECT_EQ(actuated.M.row(i), all.M.row(kActuatedIndex[i]));
+      EXPECT_EQ(actuated.NhT.row(i), all.NhT.row(kActuatedIndex[i]));
+      EXPECT_EQ(actuated.JhT.row(i), all.JhT.row(kActuatedIndex[i]));
+    }
+    // (8): the closure is the gap between two chains of the same leg, which the base moves alike, so S_f J_h' is
+    // zero up to rounding (about 1e-16 here) and the base rows drop the closure term.
+    EXPECT_LT(base.JhT.cwiseAbs().maxCoeff(), 1e-12);
+  });
+}
+
 TEST(DynamicsConstrained, PassiveClosedLoopMotionConservesEnergy) {
   // Zero torque, no contact, gravity on: the robot falls freely with its legs moving. RK4 at 1e-4 s for 1.5 s,
   // Baumgarte stabilisation of the closure (gains 20/s). Tolerances: |E(t) - E(0)| < 1e-7 J (about 1e-10 of the

@@ -110,6 +110,7 @@ void ClosedLoop::accumulate() {
   s.fall_time_s = monitor.fallTime();
   s.fall_reason = monitor.fallReason();
   s.body_contact_steps = sim_->simulator().stats().body_contact_steps;
+  s.first_body_contact = sim_->simulator().stats().first_body_contact;
   if (diag.qp_attempted && diag.status != qp::QpStatus::Optimal) ++s.non_optimal_solves;
   if (diag.safety_event != wbc::SafetyEvent::None) ++s.safety_events;
   if (diag.torque_clamped) ++s.torque_clamped_ticks;
@@ -209,7 +210,16 @@ std::string RunSummary::toJson() const {
   w.field("steps", steps).key("touchdowns").beginObject().field("early", early_touchdowns).field("late", late_touchdowns);
   w.field("forced", forced_touchdowns).endObject().field("non_optimal_solves", non_optimal_solves);
   w.field("safety_events", safety_events).field("torque_clamped_ticks", torque_clamped_ticks);
-  w.field("body_contact_steps", body_contact_steps);
+  w.field("body_contact_steps", body_contact_steps).key("first_body_contact");
+  if (first_body_contact.seen) {
+    const sim::BodyContact& b = first_body_contact;
+    w.beginObject().field("time_s", b.time_s, kDigits).field("body", sim::robotBodyName(b.body));
+    w.field("x_m", b.point.x(), kDigits).field("z_m", b.point.y(), kDigits);
+    w.field("normal_x", b.normal.x(), kDigits).field("normal_z", b.normal.y(), kDigits);
+    w.field("depth_m", b.depth_m, kDigits).endObject();
+  } else {
+    w.null();
+  }
   return w.endObject().str();
 }
 

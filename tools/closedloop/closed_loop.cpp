@@ -210,16 +210,8 @@ std::string RunSummary::toJson() const {
   w.field("steps", steps).key("touchdowns").beginObject().field("early", early_touchdowns).field("late", late_touchdowns);
   w.field("forced", forced_touchdowns).endObject().field("non_optimal_solves", non_optimal_solves);
   w.field("safety_events", safety_events).field("torque_clamped_ticks", torque_clamped_ticks);
-  w.field("body_contact_steps", body_contact_steps).key("first_body_contact");
-  if (first_body_contact.seen) {
-    const sim::BodyContact& b = first_body_contact;
-    w.beginObject().field("time_s", b.time_s, kDigits).field("body", sim::robotBodyName(b.body));
-    w.field("x_m", b.point.x(), kDigits).field("z_m", b.point.y(), kDigits);
-    w.field("normal_x", b.normal.x(), kDigits).field("normal_z", b.normal.y(), kDigits);
-    w.field("depth_m", b.depth_m, kDigits).endObject();
-  } else {
-    w.null();
-  }
+  w.field("body_contact_steps", body_contact_steps);
+  w.key("first_body_contact").raw(chain::bodyContactJson(first_body_contact));
   return w.endObject().str();
 }
 

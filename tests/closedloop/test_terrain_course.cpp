@@ -1,9 +1,10 @@
 // Blind walking over the paper's course (config/terrain/course.yaml) in process, MFT-WBC, Kalman estimator, the
 // command of `mft-experiment terrain` (0.42 m, 0.25 m/s). What is measured and why (docs/experiments.md#terrain-fig-8):
 // - the 3 cm board's leading edge stops the robot whenever the blind footfall before it lands within about
-//   2 cm of the edge (the swing leg's fore shank touches the edge), for the paper's setup and every profile set
-//   tried, at most speeds: a matter of the gait's phase at x = 1.0 m, not of the controller. These tests therefore
-//   walk the course with the board replaced by level ground (built from the course file, everything else as is);
+//   3 cm of the edge (that leg's fore shank touches the edge), for the paper's setup and every profile set
+//   tried, at most speeds: a matter of the gait's phase at x = 1.0 m and the leg's geometry, not of the
+//   controller. The last test pins that cause on the whole course; the others walk the course with the board
+//   replaced by level ground (built from the course file, everything else as is);
 // - on the 6 degree up-slope the paper's k_v = 0.16 stalls (a growing two-step oscillation of the foot placement)
 //   and the robot falls back down, while the profile kv-0.145 (k_v = 1/sigma1 of the LIP orbit) climbs it and
 //   crosses the rough ground: the minimal profile the course needs, asserted both ways below.

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "chain/command_schedule.hpp"
+#include "model/config/json_writer.hpp"
 
 namespace mft::chain {
 
@@ -59,6 +60,16 @@ RecoveryVerdict SimNode::recoveryVerdict() const {
 
 std::string SimNode::recoveryJson() const {
   return recovery_.json(scenario_.recovery, monitor_.fell(), monitor_.fallTime(), monitor_.fallReason());
+}
+
+std::string bodyContactJson(const sim::BodyContact& b) {
+  if (!b.seen) return "null";
+  constexpr int kDigits = 6;
+  config::JsonWriter w;
+  w.beginObject().field("time_s", b.time_s, kDigits).field("body", sim::robotBodyName(b.body));
+  w.field("x_m", b.point.x(), kDigits).field("z_m", b.point.y(), kDigits);
+  w.field("normal_x", b.normal.x(), kDigits).field("normal_z", b.normal.y(), kDigits);
+  return w.field("depth_m", b.depth_m, kDigits).endObject().str();
 }
 
 }  // namespace mft::chain

@@ -57,4 +57,8 @@ class SimNode {
   std::size_t first_new_impulse_ = 0, recovery_impulses_ = 0;
 };
 
+// The simulator's first non-foot terrain contact as JSON (the summaries' "first_body_contact"): body, time_s,
+// x_m, z_m, normal_x, normal_z, depth_m; null when there was none.
+std::string bodyContactJson(const sim::BodyContact& contact);
+
 }  // namespace mft::chain

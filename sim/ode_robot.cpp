@@ -133,6 +133,7 @@ void buildRobot(dWorldID world, const model::RobotDescription& d, const SimOptio
       makeHinge(r->thigh[leg][c], r->torso, hip, hi, stops[2 * c]);
       makeHinge(r->shank[leg][c], r->thigh[leg][c], knee, ki, stops[2 * c + 1]);
       if (o.link_collisions) {
+        // body_geoms order (robotBodyName): torso, then per leg and side the thigh, then the shank.
         // Shank capsules stop short of the ankle so that only the foot sphere touches the ground when standing.
         const double cut = p.foot_radius + o.link_collision_radius_m + 0.01;
         addCapsule(r->thigh[leg][c], hip, knee, o.link_collision_radius_m, &r->body_geoms);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdarg>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -76,6 +77,7 @@ struct Simulator::Impl {
   std::vector<Vector2d> feedback_normal;
   std::size_t n_feedback = 0;
   bool body_contact = false;
+  BodyContact step_body_contact;  // the first body contact found in this physics step
   double soft_erp = 0.0, soft_cfm = 0.0, friction = 0.8;
   const Terrain* terrain_desc = nullptr;
 
@@ -90,6 +92,7 @@ struct Simulator::Impl {
   // The robot geom being collided, and its leg (-1: link or torso).
   dGeomID current_geom = nullptr;
   int current_leg = -1;
+  int current_body = -1;  // index of current_geom in robot.body_geoms (-1: a foot)
 
   static void nearCallback(void* data, dGeomID o1, dGeomID o2);
   void collide();
@@ -125,6 +128,14 @@ void Simulator::Impl::nearCallback(void* data, dGeomID o1, dGeomID o2) {
       c.geom.pos[1] = centre[1];
       c.geom.pos[2] = centre[2];
     } else {
+      if (!self->body_contact) {
+        BodyContact& b = self->step_body_contact;
+        b.seen = true;
+        b.body = self->current_body;
+        b.point = Vector2d(c.geom.pos[0], c.geom.pos[1]);
+        b.normal = Vector2d(nx, ny);
+        b.depth_m = c.geom.depth;
+      }
       self->body_contact = true;
     }
     dJointID j = dJointCreateContact(self->world, self->contact_group, &c);
@@ -149,10 +160,21 @@ void Simulator::Impl::collide() {
     dSpaceCollide2(current_geom, space, this, &nearCallback);
   }
   current_leg = -1;
-  for (dGeomID g : robot.body_geoms) {
-    current_geom = g;
-    dSpaceCollide2(g, space, this, &nearCallback);
+  for (std::size_t i = 0; i < robot.body_geoms.size(); ++i) {
+    current_geom = robot.body_geoms[i];
+    current_body = static_cast<int>(i);
+    dSpaceCollide2(current_geom, space, this, &nearCallback);
   }
+  current_body = -1;
+}
+
+const char* robotBodyName(int body) {
+  // The order of OdeRobot::body_geoms (buildRobot): the torso box, then per leg (right, left) and side (rear,
+  // fore) the thigh and the shank capsule.
+  static const char* const kNames[] = {"torso",           "right rear thigh", "right rear shank",
+                                       "right fore thigh", "right fore shank", "left rear thigh",
+                                       "left rear shank",  "left fore thigh",  "left fore shank"};
+  return body >= 0 && body < static_cast<int>(std::size(kNames)) ? kNames[body] : "none";
 }
 
 Simulator::Simulator(const model::RobotDescription& robot, const SimOptions& options, const Terrain& terrain)
@@ -359,7 +381,13 @@ void Simulator::physicsStep(int substep) {
     }
     m.in_contact[leg] = now;
   }
-  if (m.body_contact) ++stats_.body_contact_steps;
+  if (m.body_contact) {
+    ++stats_.body_contact_steps;
+    if (!stats_.first_body_contact.seen) {
+      stats_.first_body_contact = m.step_body_contact;
+      stats_.first_body_contact.time_s = t0;
+    }
+  }
   if (options_.actuator_model == ActuatorModel::Sea)
     for (std::size_t i = 0; i < static_cast<std::size_t>(kNa); ++i) m.sea[i].advance(m.sea_input[i]);
   if (options_.actuator_model == ActuatorModel::SeaMotor)

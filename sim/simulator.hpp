@@ -58,6 +58,19 @@ struct AppliedImpulse {
   std::uint64_t id = 0;  // ImpulseSpec::id
 };
 
+// The first contact of a non-foot body with the terrain since reset: which body, when and where. A diagnosis of
+// falls by body contact (e.g. a shank on an obstacle's edge), not used by the simulation itself.
+struct BodyContact {
+  bool seen = false;
+  double time_s = 0.0;  // start of the physics step
+  int body = -1;        // robotBodyName(body): torso, then per leg (right, left) and side (rear, fore) thigh, shank
+  Eigen::Vector2d point{0.0, 0.0};   // contact point, world [x, z]
+  Eigen::Vector2d normal{0.0, 0.0};  // contact normal, world [x, z], pointing into the robot's body
+  double depth_m = 0.0;              // penetration
+};
+// "torso", "right rear thigh", "right rear shank", "right fore thigh", ..., "left fore shank"; "none" otherwise.
+const char* robotBodyName(int body);
+
 struct SimStats {
   std::uint64_t control_steps = 0;
   std::uint64_t physics_steps = 0;
@@ -67,6 +80,7 @@ struct SimStats {
   std::array<std::uint64_t, model::kNumLegs> liftoffs{};
   std::array<double, model::kNumLegs> last_liftoff_time_s{-1.0, -1.0};
   std::uint64_t body_contact_steps = 0;  // physics steps in which a thigh, shank or the torso touched the ground
+  BodyContact first_body_contact;        // the first of those contacts
   std::uint64_t ode_messages = 0;        // ODE warnings (e.g. LCP internal errors) since reset
   std::vector<AppliedImpulse> impulses;  // applied so far
 };

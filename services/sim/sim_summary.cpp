@@ -63,6 +63,8 @@ std::string simSummaryJson(const SimRun& r) {
   w.fixedField("final_base_height_m", sim.groundTruth().q[1], 5).field("impulses_applied", stats.impulses.size());
   w.field("max_closure_error_m", stats.max_closure_error_m, 3);
   w.key("touchdowns").beginArray().value(stats.touchdowns[0]).value(stats.touchdowns[1]).endArray();
+  w.field("body_contact_steps", stats.body_contact_steps);
+  w.key("first_body_contact").raw(chain::bodyContactJson(stats.first_body_contact));
   w.field("error", r.error).field("commands_received", driver.commandsReceived());
   w.key("commands_rejected").beginObject().field("nonfinite", driver.refused(chain::InputVerdict::NonFinite));
   w.field("out_of_range", driver.refused(chain::InputVerdict::OutOfRange));

@@ -110,6 +110,7 @@ void ClosedLoop::accumulate() {
   s.fall_time_s = monitor.fallTime();
   s.fall_reason = monitor.fallReason();
   s.body_contact_steps = sim_->simulator().stats().body_contact_steps;
+  s.first_body_contact = sim_->simulator().stats().first_body_contact;
   if (diag.qp_attempted && diag.status != qp::QpStatus::Optimal) ++s.non_optimal_solves;
   if (diag.safety_event != wbc::SafetyEvent::None) ++s.safety_events;
   if (diag.torque_clamped) ++s.torque_clamped_ticks;
@@ -210,6 +211,7 @@ std::string RunSummary::toJson() const {
   w.field("forced", forced_touchdowns).endObject().field("non_optimal_solves", non_optimal_solves);
   w.field("safety_events", safety_events).field("torque_clamped_ticks", torque_clamped_ticks);
   w.field("body_contact_steps", body_contact_steps);
+  w.key("first_body_contact").raw(chain::bodyContactJson(first_body_contact));
   return w.endObject().str();
 }
 

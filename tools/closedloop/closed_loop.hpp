@@ -20,6 +20,7 @@
 #include "model/mft_polytope.hpp"
 #include "model/robot_description.hpp"
 #include "sim/sim_options.hpp"
+#include "sim/simulator.hpp"
 #include "sim/terrain.hpp"
 #include "wbc/wbc_config.hpp"
 
@@ -79,6 +80,7 @@ struct RunSummary {
   std::uint64_t steps = 0;             // planner lift-offs
   std::uint64_t non_optimal_solves = 0, safety_events = 0, torque_clamped_ticks = 0;
   std::uint64_t body_contact_steps = 0;
+  sim::BodyContact first_body_contact;  // which body touched the terrain first, when and where
   std::uint64_t forced_touchdowns = 0, late_touchdowns = 0, early_touchdowns = 0;
   std::string toJson() const;
 };

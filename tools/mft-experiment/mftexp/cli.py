@@ -144,6 +144,10 @@ def add_search(p, default):
     p.add_argument("--coarse", type=positive, default=0.5, help="coarse step of --search coarse [N s] (default 0.5)")
     p.add_argument("--above", type=float, default=1.0,
                    help="also run this far above the first failure [N s] to report recoveries there (default 1)")
+    p.add_argument("--no-speculation", dest="speculate", action="store_false",
+                   help="a slot with no cell left to start stays idle; by default it runs the impulses a cell's "
+                        "search will ask for next if the runs in flight recover, and the search takes their "
+                        "outcomes when it gets there (the same runs, results and table; only the wall time differs)")
     p.add_argument("--inprocess", action="store_true",
                    help="run mft-closedloop (the same libraries, configs and recovery verdict in one process, about "
                         "8x faster here) instead of the multi-process stack")

@@ -144,7 +144,6 @@ static int toolMain(int argc, char** argv) {
   services::writeSummaryFile(cli.get("summary"), w.endObject().str(), "mft-record");
   return s.error.empty() ? 0 : 1;
 }
-
 // I/O errors and anything else escaping the main: one line and a documented exit status, never an abort.
 int main(int argc, char** argv) {
   return mft::config::guardedMain("mft-record", [&] { return toolMain(argc, argv); });

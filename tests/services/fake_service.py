@@ -59,6 +59,11 @@ crashes = int(crash_file.read_text()) if crash_file.exists() else 0
 stop = False
 
 
+def started_before(service):
+    """How many times SERVICE has been started so far, this start included ($FAKE_PID_LOG)."""
+    return sum(1 for l in Path(os.environ["FAKE_PID_LOG"]).read_text().splitlines() if l.split()[0] == service)
+
+
 def on_term(*_):
     global stop
     stop = True
@@ -66,6 +71,11 @@ def on_term(*_):
 
 signal.signal(signal.SIGTERM, signal.SIG_IGN if "ignore_term" in behaviour else on_term)  # a service hung at stop
 signal.signal(signal.SIGINT, on_term)
+# stuck_start=N: the first N starts (counted in $FAKE_PID_LOG) end as a secured simulator does whose chain never
+# answered tick 0 (a DDS Security handshake stuck further down the chain).
+if started_before(name) <= int(behaviour.get("stuck_start", "0")):
+    print(f"{name}: timeout: no JointCommand for tick 0 within 10 s (is mft-wbc running?)", file=sys.stderr, flush=True)
+    sys.exit(3)
 if "fail_start" in behaviour:  # exits before it is ready, with this message
     print(f"{name}: {behaviour['fail_start']}", flush=True)
     sys.exit(3)

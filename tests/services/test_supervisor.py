@@ -157,6 +157,28 @@ class SupervisorTest(FakeStack, unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("no stack is up on domain 11", r.stderr)
 
+    def test_a_secured_chain_that_never_answers_tick_0_is_started_again(self):
+        # Fast DDS 2.9.1's secure handshake can stick on a hop past the simulator's own readers: the simulator's
+        # endpoints match, tick 0 never comes back, and it exits 3. `run --secure` starts the stack once more.
+        sec = self.tmp / "sec"
+        sec.mkdir()
+        for f in ["ca.pem", "governance.p7s"] + [f"{s[4:]}{ext}" for s in SERVICES[:4] for ext in (".pem", ".key")] \
+                + [f"permissions_{s[4:]}.p7s" for s in SERVICES[:4]]:
+            (sec / f).touch()
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "34", "--secure", str(sec), "--json",
+                                         fake="mft-sim:stuck_start=1:run_for=0.2")
+        self.assertEqual(code, 0, err)
+        self.assertTrue(json.loads(out)["ok"], out)
+        self.assertIn("the secured chain did not connect", err)
+        self.assertIn("attempt 2 of", err)
+        self.assertEqual(sum(1 for l in self.pid_log.read_text().splitlines() if l.startswith("mft-sim ")), 2)
+        # A timeout at a later tick is a real failure: no second start.
+        self.pid_log.unlink()
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "34", "--json",
+                                         fake="mft-sim:stuck_start=1:run_for=0.2")
+        self.assertEqual(code, 1, err)  # not secured: a stuck start is not retried
+        self.assertNotIn("attempt 2 of", err)
+
     def test_up_goes_down_when_the_watched_process_ends(self):
         # A test killed by CTest's timeout passes its pid to `up --watch-pid`: its stack must not outlive it.
         env = dict(self.env, FAKE_SERVICES="")

@@ -7,6 +7,8 @@ hits every measurement alike:
   * one plain lockstep run per variant through services/mft-supervisor and the real services, traced hop by
     hop (MFT_HOP_TRACE): the per-tick split into each DDS hop and each service's compute, p50/p99/max;
   * one lockstep run recording every topic (the recording cost, against the round's first variant).
+Then the machine's own wake-up floor (mft-wakeup: 1 kHz timer lateness per CPU, thread wake-ups on one core
+and across cores), the figure each hop and the realtime latency stand on.
 Reported: each variant's real-time factor, its ratio to the in-process speed (per round, in-process wall time
 over lockstep wall time, and the median over the rounds), the hop table of its median run, the recording
 slowdown, and (unless --skip-realtime) the realtime sensor-to-command latency over a --realtime-s run.
@@ -185,8 +187,26 @@ def measure(args, tmp):
         out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["deadline_misses"],
                            "sensor_to_command_latency_us": s["sensor_to_command_latency_us"],
                            "wbc_tick_us": s.get("wbc_tick_us"), "fell": s["fell"]}
+    if not args.skip_wakeup:
+        out["machine_wakeup"] = run_wakeup_probe(args)
     out["load_average_after"] = load_average()
     return out
+
+
+def run_wakeup_probe(args):
+    """The machine's own floor (mft-wakeup --rt, SCHED_FIFO as the realtime stack when permitted): 1 kHz timer
+    lateness per CPU, thread wake-ups on one core and across cores."""
+    exe = Path(args.bin_dir) / "mft-wakeup"
+    if not exe.exists():
+        raise MeasureError(f"no mft-wakeup in {args.bin_dir} (build it, or pass --skip-wakeup)")
+    progress(f"machine wake-up probe (load {os.getloadavg()[0]:.2f}) ...")
+    try:
+        p = subprocess.run([str(exe), "--json", "--rt"], capture_output=True, text=True, timeout=120)
+        return json.loads(p.stdout)
+    except subprocess.TimeoutExpired:
+        raise MeasureError("mft-wakeup did not finish within 120 s")
+    except ValueError:
+        raise MeasureError(f"mft-wakeup gave no figures (exit {p.returncode}): {p.stderr.strip()[-300:]}")
 
 
 def print_report(out):
@@ -215,6 +235,13 @@ def print_report(out):
         lat = rt["sensor_to_command_latency_us"]
         print(f"realtime, {rt['sim_s']:g} s: sensor-to-command latency p50 {lat['p50']:.0f} us, p99 {lat['p99']:.0f} us, "
               f"max {lat['max']:.0f} us over {lat['count']} ticks; deadline misses {rt['deadline_misses']}")
+    if "machine_wakeup" in out:
+        w = out["machine_wakeup"]
+        timers = ", ".join(f"{cpu} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}" for cpu, t in w["timer_late_us"].items())
+        wake = ", ".join(f"{where.replace('_', ' ')} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}"
+                         for where, t in w["wakeup_us"].items())
+        print(f"machine wake-up floor (mft-wakeup, {w['scheduling']}) [us]: 1 kHz timer late: {timers}; "
+              f"thread wake-up: {wake}")
 
 
 def reexec_in_private_net():
@@ -244,6 +271,7 @@ def main():
                     "options (repeatable; each round runs every variant once, interleaved)")
     ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
     ap.add_argument("--skip-recording", action="store_true", help="no recorded runs")
+    ap.add_argument("--skip-wakeup", action="store_true", help="no machine wake-up probe (mft-wakeup)")
     ap.add_argument("--no-hops", action="store_true", help="do not trace the plain lockstep runs hop by hop")
     ap.add_argument("--hops", action="store_true", help=argparse.SUPPRESS)  # the default now; kept for old commands
     ap.add_argument("--private-net", action="store_true", help="run inside a private network namespace (unshare -n)")

@@ -71,14 +71,19 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
     return cpu
 
 
-def cpu_placement(chain_cpu, names):
-    """The chain (sim, estimator, planner, wbc) on CPU `chain_cpu` (None: no pinning), the recorder on the
-    others, where it works without taking the chain's core."""
+def cpu_placement(chain_cpu, names, recorder_elsewhere=True):
+    """The chain (sim, estimator, planner, wbc) on CPU `chain_cpu` (None: no pinning); the recorder on the other
+    CPUs when `recorder_elsewhere` (an explicit --chain-cpu N), else free. "auto" leaves it free: the lockstep
+    recorder's threads are SCHED_IDLE, and confined to a core that something else keeps busy (another stack's
+    chain in mft-experiment, another job) it starved until the simulator's recorder window timed out (measured:
+    rawlog_integration's starved-recorder run on a loaded machine); free, it also takes the chain's core
+    whenever the chain waits for it."""
     if chain_cpu is None:
         return {}
     allowed = sorted(os.sched_getaffinity(0))
     others = [c for c in allowed if c != chain_cpu] or [chain_cpu]
-    return {n: ({chain_cpu} if n in CORE_SERVICES + ["mft-sim"] else set(others)) for n in names}
+    return {n: {chain_cpu} if n in CORE_SERVICES + ["mft-sim"] else set(others)
+            for n in names if n in CORE_SERVICES + ["mft-sim"] or recorder_elsewhere}
 
 
 class Service:
@@ -190,7 +195,8 @@ class Stack:
             self.services[DISCOVERY_SERVER] = Service(DISCOVERY_SERVER, argv, self.run_dir, summary=False,
                                                       ready_line=DISCOVERY_SERVER_READY, host=host)
         self.chain_cpu = chain_cpu_for(getattr(args, "chain_cpu", None), args.mode, args.domain, bool(self.stack))
-        placement = cpu_placement(self.chain_cpu, names)
+        explicit = getattr(args, "chain_cpu", None) not in (None, "auto", "none")
+        placement = cpu_placement(self.chain_cpu, names, recorder_elsewhere=explicit)
         for name in names:
             argv = [str(Path(args.bin_dir) / name)] + common
             host = None

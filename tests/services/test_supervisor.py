@@ -90,6 +90,8 @@ class ChainPlacementTest(unittest.TestCase):
         self.assertEqual(placement["mft-sim"], {allowed[0]})
         self.assertEqual(placement["mft-record"], set(allowed[1:]) or {allowed[0]})
         self.assertEqual(cpu_placement(None, ["mft-wbc"]), {})
+        auto = cpu_placement(allowed[0], ["mft-wbc", "mft-sim", "mft-record"], recorder_elsewhere=False)
+        self.assertEqual(auto, {"mft-wbc": {allowed[0]}, "mft-sim": {allowed[0]}})  # the recorder stays free
 
 
 class SupervisorTest(FakeStack, unittest.TestCase):

@@ -135,6 +135,9 @@ def measure(args, tmp):
     variants = parse_variants(args.variant, args.chain_cpu)
     out = {"cpus": os.cpu_count(), "allowed_cpus": sorted(os.sched_getaffinity(0)), "scenario": str(args.scenario),
            "rounds": args.runs, "load_average_before": load_average(), "load_averages_per_round": []}
+    if os.getloadavg()[0] > 0.5 * (os.cpu_count() or 1):
+        progress(f"measure-stack: warning: load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cpus: other jobs "
+                 "slow the in-process reference and the stack unevenly, so the ratio is not a figure to quote")
     inprocess = []
     plain = {label: [] for label, _ in variants}
     recorded = []

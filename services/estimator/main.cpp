@@ -3,7 +3,6 @@
 // tick; in the scenario's ground_truth mode it passes the simulator's truth through.
 #include <chrono>
 #include <cstdio>
-#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -74,46 +73,22 @@ static int toolMain(int argc, char** argv) {
         have_sensors = true;
         process(true);
       });
-  using TruthReader = services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType>;
-  const auto makeTruthReader = [&] {
-    return std::make_unique<TruthReader>(ctx.participant(), "GroundTruth", ctx.chainReaderProfile(),
-                                         [&](const msg::GroundTruth& m) {
-                                           std::lock_guard<std::mutex> lock(mutex);
-                                           if (!join.accept(services::validInput(m), "GroundTruth", m.tick())) return;
-                                           services::fromMsg(m, &truth);
-                                           have_truth = true;
-                                           process(false);
-                                         });
-  };
-  std::unique_ptr<TruthReader> truth_reader = makeTruthReader();
-  std::uint64_t truth_reader_dropped = 0;
+  services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
+      ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!join.accept(services::validInput(m), "GroundTruth", m.tick())) return;
+        services::fromMsg(m, &truth);
+        have_truth = true;
+        process(false);
+      });
 
   services::announceReady("mft-estimator");
-  while (!services::shutdownRequested()) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    // Lockstep with the Kalman filter: GroundTruth is needed at the first tick only (and again after a new
-    // clock), yet each sample would wake this process on the chain's one core at every tick (tick p50 -8 %
-    // without it, docs/loop-benchmark.md). So the reader goes once the filter runs and comes back when it needs
-    // the truth again. Realtime keeps it: a restarted estimator must start at once. Never under the mutex:
-    // deleting a reader waits for its callback, which may be waiting for the mutex.
-    if (!ctx.lockstep()) continue;
-    bool needs_truth;
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      needs_truth = node.needsTruth();
-    }
-    if (!needs_truth && truth_reader) {
-      truth_reader.reset();
-      ++truth_reader_dropped;
-    } else if (needs_truth && !truth_reader) {
-      truth_reader = makeTruthReader();
-    }
-  }
+  while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
   config::JsonWriter w;
   w.beginObject().field("service", "mft-estimator").field("mode", ctx.scenario().estimator);
-  w.field("ticks", join.ticks()).field("last_tick", join.lastTick()).field("truth_reader_dropped", truth_reader_dropped);
+  w.field("ticks", join.ticks()).field("last_tick", join.lastTick());
   join.writeCounts(w);
   w.field("deadline_misses", sensor_reader.requestedDeadlineMisses()).key("update_time_us").raw(update_us.json());
   ctx.writeSummary(w.endObject().str());

@@ -103,6 +103,8 @@ def run_stack(args, tmp, scenario, mode, tag, extra=(), record=False, hops=False
     if record and rawlog.exists():
         rawlog.unlink()
     sim = dict(summary["services"]["mft-sim"])
+    for key in ("deadline_misses", "sensor_to_command_latency_us", "wbc_tick_us", "chain_cpu"):
+        sim["run_" + key] = summary.get(key)  # the supervisor's figures over every service
     if hops:
         sim["hop_table"] = hop_table_module().hop_table(run_dir)
     if "mft-record" in summary["services"]:
@@ -167,7 +169,7 @@ def measure(args, tmp):
              "real_time_factor_median": round(runs[0]["sim_time_s"] / statistics.median(wall), 2),
              "us_per_tick_median": round(statistics.median(wall) / max(1, runs[0]["ticks"]) * 1e6, 1),
              "ratio_to_inprocess_per_round": ratios, "ratio_to_inprocess_median": median(ratios),
-             "resends": sum(s.get("lockstep_resends", 0) for s in runs)}
+             "resends": sum(s.get("lockstep_resends", 0) for s in runs), "chain_cpu": [s["run_chain_cpu"] for s in runs]}
         if not args.no_hops:  # the table of the run with the median wall time
             v["hop_table"] = sorted(runs, key=lambda s: s["wall_time_s"])[len(runs) // 2]["hop_table"]
         out["lockstep"][label] = v
@@ -187,9 +189,10 @@ def measure(args, tmp):
         scenario.write_text(text.replace("name: step-in-place", "name: step-in-place-long"))
         progress(f"realtime run of {args.realtime_s:g} s (load {os.getloadavg()[0]:.2f}) ...")
         s = run_stack(args, tmp, scenario, "realtime", "rt", variants[0][1], timeout_s=args.realtime_s + 300)
-        out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["deadline_misses"],
-                           "sensor_to_command_latency_us": s["sensor_to_command_latency_us"],
-                           "wbc_tick_us": s.get("wbc_tick_us"), "fell": s["fell"]}
+        out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["run_deadline_misses"],
+                           "sensor_to_command_latency_us": s["run_sensor_to_command_latency_us"],
+                           "wbc_tick_us": s["run_wbc_tick_us"], "fell": s["fell"], "chain_cpu": s["run_chain_cpu"],
+                           "sim_wakeup_late_us": s.get("sim_wakeup_late_us")}
     if not args.skip_wakeup:
         out["machine_wakeup"] = run_wakeup_probe(args)
     out["load_average_after"] = load_average()

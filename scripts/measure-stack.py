@@ -188,11 +188,17 @@ def measure(args, tmp):
         text = Path(args.scenario).read_text().replace("duration_s: 10.0", f"duration_s: {args.realtime_s}")
         scenario.write_text(text.replace("name: step-in-place", "name: step-in-place-long"))
         progress(f"realtime run of {args.realtime_s:g} s (load {os.getloadavg()[0]:.2f}) ...")
-        s = run_stack(args, tmp, scenario, "realtime", "rt", variants[0][1], timeout_s=args.realtime_s + 300)
+        extra = variants[0][1] + (["--stall-probe"] if args.stall_probe else [])
+        s = run_stack(args, tmp, scenario, "realtime", "rt", extra, timeout_s=args.realtime_s + 300)
         out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["run_deadline_misses"],
                            "sensor_to_command_latency_us": s["run_sensor_to_command_latency_us"],
                            "wbc_tick_us": s["run_wbc_tick_us"], "fell": s["fell"], "chain_cpu": s["run_chain_cpu"],
-                           "sim_wakeup_late_us": s.get("sim_wakeup_late_us")}
+                           "sim_wakeup_late_us": s.get("sim_wakeup_late_us"),
+                           # the simulator's watchdog misses (a tick > 3 ms without its command), and with
+                           # --stall-probe which of them fell in a stall of the machine
+                           "sim_deadline_misses": s.get("deadline_misses"),
+                           "sim_misses_during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
+                           "sim_misses_unexplained": s.get("deadline_misses_unexplained")}
     if not args.skip_wakeup:
         out["machine_wakeup"] = run_wakeup_probe(args)
     out["load_average_after"] = load_average()
@@ -240,7 +246,10 @@ def print_report(out):
         rt = out["realtime"]
         lat = rt["sensor_to_command_latency_us"]
         print(f"realtime, {rt['sim_s']:g} s: sensor-to-command latency p50 {lat['p50']:.0f} us, p99 {lat['p99']:.0f} us, "
-              f"max {lat['max']:.0f} us over {lat['count']} ticks; deadline misses {rt['deadline_misses']}")
+              f"max {lat['max']:.0f} us over {lat['count']} ticks; deadline misses {rt['deadline_misses']} (readers and "
+              f"simulator), of the simulator {rt['sim_deadline_misses']}"
+              + (f": {rt['sim_misses_during_cpu_stalls']} during CPU stalls, {rt['sim_misses_unexplained']} unexplained"
+                 if rt.get("sim_misses_unexplained") is not None else ""))
     if "machine_wakeup" in out:
         w = out["machine_wakeup"]
         timers = ", ".join(f"{cpu} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}" for cpu, t in w["timer_late_us"].items())
@@ -277,6 +286,8 @@ def main():
                     "options (repeatable; each round runs every variant once, interleaved)")
     ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
     ap.add_argument("--skip-recording", action="store_true", help="no recorded runs")
+    ap.add_argument("--stall-probe", action="store_true", help="realtime run with the simulator's CPU stall probe: "
+                    "each deadline miss attributed to a stall of the machine or to the chain (costs ~30 us of p50)")
     ap.add_argument("--skip-wakeup", action="store_true", help="no machine wake-up probe (mft-wakeup)")
     ap.add_argument("--no-hops", action="store_true", help="do not trace the plain lockstep runs hop by hop")
     ap.add_argument("--hops", action="store_true", help=argparse.SUPPRESS)  # the default now; kept for old commands

@@ -42,46 +42,17 @@ def _set_pdeathsig():
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
 
-def cpu_busy_fractions(cpus, interval_s=0.1):
-    """The share of each CPU's time spent busy over `interval_s` (from /proc/stat; {} where it cannot be read)."""
-    def sample():
-        out = {}
-        try:
-            with open("/proc/stat") as f:
-                for line in f:
-                    name, *fields = line.split()
-                    if name.startswith("cpu") and name[3:].isdigit() and int(name[3:]) in cpus:
-                        values = [int(v) for v in fields]
-                        out[int(name[3:])] = (sum(values), values[3] + (values[4] if len(values) > 4 else 0))
-        except (OSError, ValueError, IndexError):
-            return {}
-        return out
-    before = sample()
-    time.sleep(interval_s)
-    after = sample()
-    busy = {}
-    for cpu in cpus:
-        if cpu in before and cpu in after and after[cpu][0] > before[cpu][0]:
-            total, idle = after[cpu][0] - before[cpu][0], after[cpu][1] - before[cpu][1]
-            busy[cpu] = 1.0 - idle / total
-    return busy
-
-
-BUSY_CPU_FRACTION = 0.5  # "auto" passes over a CPU busier than this when the stack starts
-
-
-def chain_cpu_for(chain_cpu, mode, domain, multi_host, busy=cpu_busy_fractions):
+def chain_cpu_for(chain_cpu, mode, domain, multi_host):
     """The CPU the control chain is pinned to, or None: --chain-cpu N, "none" (no pinning) or "auto" (the
     default when the option is not given).
 
     A lockstep tick is a relay (sim -> estimator -> planner -> wbc -> sim) in which one process runs at a time:
     on one core every hand-off is a local wake-up, while a wake-up on another, idle, vCPU costs tens of us on
-    a VM (docs/loop-benchmark.md). "auto" pins a lockstep stack to one of the CPUs this process may use: the
-    one its DDS domain picks (domain modulo the CPUs), so that the stacks of mft-experiment's local workers
-    (consecutive domains) each get their own core, unless that CPU is busy at the start (another job: a pinned
-    chain could not leave it), then the next one that is not; realtime stacks and multi-host stacks (--stack)
-    are not pinned by "auto". Measured (docs/loop-benchmark.md, interleaved A/B): the pinned chain ran a
-    lockstep tick in 0.65-0.71x the time of the unpinned one at load 2-4, and lost under heavy load."""
+    a VM (docs/loop-benchmark.md). "auto" pins a lockstep stack to one of the CPUs this process may use, chosen
+    by its DDS domain, so that the stacks of mft-experiment's local workers (consecutive domains) each get
+    their own core; realtime stacks and multi-host stacks (--stack) are not pinned by "auto". Measured
+    (docs/loop-benchmark.md, interleaved A/B under load): the pinned chain ran a lockstep tick in ~0.7x the time
+    of the unpinned one."""
     if chain_cpu is None:
         chain_cpu = "auto"
     if chain_cpu == "none":
@@ -90,10 +61,7 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host, busy=cpu_busy_fractions):
     if chain_cpu == "auto":
         if mode != "lockstep" or multi_host:
             return None
-        start = domain % len(allowed)
-        order = allowed[start:] + allowed[:start]
-        fractions = busy(order) if len(order) > 1 else {}
-        return next((c for c in order if fractions.get(c, 0.0) <= BUSY_CPU_FRACTION), order[0])
+        return allowed[domain % len(allowed)]
     try:
         cpu = int(chain_cpu)
     except (TypeError, ValueError):

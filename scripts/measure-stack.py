@@ -1,17 +1,31 @@
 #!/usr/bin/env python3
-"""Loop benchmark of the multi-process stack (docs/benchmarks.md "Loop benchmark").
+"""Loop benchmark of the multi-process stack (docs/loop-benchmark.md, docs/benchmarks.md "Loop benchmark").
 
-Measures, through services/mft-supervisor and the real services:
-  * lockstep speed: wall time of the simulator's loop for a 10 s step-in-place run, as a real-time factor;
-  * recording cost: the same runs with mft-record recording every topic, alternated with plain ones;
-  * realtime latency: sensor-to-command latency (SensorData(k) written -> JointCommand(k) received by the sim)
-    p50 / p99 / max over a --realtime-s run, with the deadline misses.
-Speed figures depend on the machine and on its load: run it on an idle machine (the load is printed).
+Runs rounds of the same scenario (10 s step in place), each round interleaved so that a shared machine's load
+hits every measurement alike:
+  * the in-process reference: mft-closedloop, the whole chain in one process (no DDS);
+  * one plain lockstep run per variant through services/mft-supervisor and the real services, traced hop by
+    hop (MFT_HOP_TRACE): the per-tick split into each DDS hop and each service's compute, p50/p99/max;
+  * one lockstep run recording every topic (the recording cost, against the round's first variant).
+Then the machine's own wake-up floor (mft-wakeup: 1 kHz timer lateness per CPU, thread wake-ups on one core
+and across cores), the figure each hop and the realtime latency stand on.
+Reported: each variant's real-time factor, its ratio to the in-process speed (per round, in-process wall time
+over lockstep wall time, and the median over the rounds), the hop table of its median run, the recording
+slowdown, and (unless --skip-realtime) the realtime sensor-to-command latency over a --realtime-s run.
+The load average is recorded before and after: run it on an idle machine for figures to quote.
+
+Variants (--variant LABEL=ARGS, repeatable) are extra supervisor options, for A/B comparisons in one command:
+  measure-stack.py --variant pinned="--chain-cpu auto" --variant free="--chain-cpu none" --skip-realtime
+Without --variant there is one, "default" (the supervisor's defaults).
+Multi-process runs should not share a DDS domain with anything else: --private-net runs the whole measurement
+in a private network namespace (needs root or user namespaces; `unshare -n`), as the tests do.
 """
 import argparse
 import importlib.util
 import json
 import os
+import shlex
+import shutil
 import statistics
 import subprocess
 import sys
@@ -20,13 +34,25 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
 from mftstack.scripts import run_script  # noqa: E402
-from mftstack.paths import DEFAULT_BIN, SCENARIOS, SUPERVISOR  # noqa: E402
+from mftstack.paths import DEFAULT_BIN, REPO, SCENARIOS, SUPERVISOR  # noqa: E402
 
 SCENARIO = SCENARIOS / "step-in-place.yaml"
+LOCKSTEP_TIMEOUT_S = 300  # one 10 s lockstep run takes 1-10 s; a stuck one is ended (with its services)
+INPROCESS_TIMEOUT_S = 120
+NETNS_ENV = "MFT_MEASURE_STACK_NETNS"
+
+
+class MeasureError(Exception):
+    pass
 
 
 def progress(msg):
     print(msg, file=sys.stderr, flush=True)
+
+
+def load_average():
+    one, five, fifteen = os.getloadavg()
+    return {"1min": round(one, 2), "5min": round(five, 2), "15min": round(fifteen, 2)}
 
 
 def hop_table_module():
@@ -36,7 +62,22 @@ def hop_table_module():
     return module
 
 
-def run_stack(args, tmp, scenario, mode, record=False, tag="", hops=False):
+def run_inprocess(args):
+    cmd = [str(Path(args.bin_dir) / "mft-closedloop"), "--scenario", str(args.scenario), "--json"]
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=INPROCESS_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        raise MeasureError(f"mft-closedloop did not finish within {INPROCESS_TIMEOUT_S} s")
+    try:
+        summary = json.loads(p.stdout)["summary"]
+    except (ValueError, KeyError):
+        raise MeasureError(f"mft-closedloop gave no summary (exit {p.returncode}): {p.stderr.strip()[-500:]}")
+    if p.returncode != 0:
+        raise MeasureError(f"mft-closedloop failed (exit {p.returncode}): {p.stderr.strip()[-500:]}")
+    return summary
+
+
+def run_stack(args, tmp, scenario, mode, tag, extra=(), record=False, hops=False, timeout_s=LOCKSTEP_TIMEOUT_S):
     run_dir = Path(tmp) / f"run-{mode}-{tag}"
     env = dict(os.environ)
     env.pop("MFT_HOP_TRACE", None)
@@ -44,106 +85,239 @@ def run_stack(args, tmp, scenario, mode, record=False, tag="", hops=False):
         run_dir.mkdir(parents=True, exist_ok=True)
         env["MFT_HOP_TRACE"] = str(run_dir)
     cmd = [sys.executable, str(SUPERVISOR), "run", str(scenario), "--domain", str(args.domain), "--mode", mode,
-           "--json", "--run-dir", str(run_dir), "--bin-dir", str(args.bin_dir)]
+           "--json", "--run-dir", str(run_dir), "--bin-dir", str(args.bin_dir)] + list(extra)
+    rawlog = Path(tmp) / f"{tag}.rawlog"
     if record:
-        cmd += ["--record", str(Path(tmp) / f"{tag}.rawlog")]
-    if args.chain_cpu is not None:
-        cmd += ["--chain-cpu", str(args.chain_cpu)]
-    p = subprocess.run(cmd, capture_output=True, text=True, timeout=args.realtime_s + 300, env=env)
+        cmd += ["--record", str(rawlog)]
+    try:
+        # The supervisor's children die with it (PR_SET_PDEATHSIG), so ending it on a timeout ends the stack.
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s, env=env)
+    except subprocess.TimeoutExpired:
+        raise MeasureError(f"the {mode} run {tag} did not finish within {timeout_s:.0f} s (logs: {run_dir})")
     try:
         summary = json.loads(p.stdout)
     except ValueError:
-        sys.exit(f"measure-stack: the {mode} run gave no summary (exit {p.returncode}):\n{p.stderr[-2000:]}")
+        raise MeasureError(f"the {mode} run {tag} gave no summary (exit {p.returncode}): {p.stderr.strip()[-1500:]}")
     if p.returncode != 0 or not summary.get("ok"):
-        sys.exit(f"measure-stack: the {mode} run failed: {summary.get('error')} {summary.get('failed')}")
-    if record:
-        os.unlink(Path(tmp) / f"{tag}.rawlog")
+        raise MeasureError(f"the {mode} run {tag} failed: {summary.get('error')} {summary.get('failed')}")
+    if record and rawlog.exists():
+        rawlog.unlink()
+    sim = dict(summary["services"]["mft-sim"])
+    for key in ("deadline_misses", "sensor_to_command_latency_us", "wbc_tick_us", "chain_cpu"):
+        sim["run_" + key] = summary.get(key)  # the supervisor's figures over every service
     if hops:
-        summary["hop_table"] = hop_table_module().hop_table(run_dir)
-    return summary
+        sim["hop_table"] = hop_table_module().hop_table(run_dir)
+    if "mft-record" in summary["services"]:
+        sim["recorder_dropped_samples"] = summary["services"]["mft-record"].get("dropped_samples")
+    shutil.rmtree(run_dir, ignore_errors=True)
+    return sim
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables")
-    ap.add_argument("--domain", type=int, default=71, help="DDS domain id for the runs (default 71)")
-    ap.add_argument("--runs", type=int, default=3, help="lockstep runs with and without recording (default 3)")
-    ap.add_argument("--realtime-s", type=float, default=60.0, help="length of the realtime run [s] (default 60)")
-    ap.add_argument("--chain-cpu", type=int, metavar="N", help="pass --chain-cpu N to the supervisor (chain on CPU N, "
-                    "recorder on the others)")
-    ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
-    ap.add_argument("--hops", action="store_true", help="trace the plain lockstep runs (MFT_HOP_TRACE) and print the "
-                    "per-hop table of the median one (scripts/hop-table.py; docs/loop-benchmark.md)")
-    ap.add_argument("--json", action="store_true", help="print the figures as JSON")
-    args = ap.parse_args()
-    if not (Path(args.bin_dir) / "mft-sim").exists():
-        sys.exit(f"measure-stack: no mft-sim in {args.bin_dir} (build first: bash scripts/build.sh release)")
-    if args.runs < 1 or args.realtime_s < 1:
-        sys.exit("measure-stack: --runs and --realtime-s must be at least 1")
+def parse_variants(specs, chain_cpu):
+    variants = []
+    for spec in specs or []:
+        label, sep, rest = spec.partition("=")
+        if not sep or not label.strip():
+            raise MeasureError(f"--variant {spec!r}: expected LABEL=SUPERVISOR-OPTIONS")
+        variants.append((label.strip(), shlex.split(rest)))
+    if not variants:
+        variants = [("default", [])]
+    if chain_cpu is not None:
+        variants = [(label, ["--chain-cpu", chain_cpu] + extra) for label, extra in variants]
+    if len({label for label, _ in variants}) != len(variants):
+        raise MeasureError("--variant: the labels must differ")
+    return variants
 
-    out = {"cpus": os.cpu_count(), "chain_cpu": args.chain_cpu, "load_per_core_before": round(os.getloadavg()[0] / (os.cpu_count() or 1), 2)}
-    with tempfile.TemporaryDirectory(prefix="mft-measure-") as tmp:
-        plain, recorded = [], []
-        for i in range(args.runs):
-            progress(f"lockstep run {i + 1}/{args.runs} without and with recording ...")
-            s = run_stack(args, tmp, SCENARIO, "lockstep", tag=f"plain{i}", hops=args.hops)
-            plain.append(dict(s["services"]["mft-sim"], hop_table=s.get("hop_table")))
-            rec = run_stack(args, tmp, SCENARIO, "lockstep", record=True, tag=f"rec{i}")
-            recorded.append(rec["services"]["mft-sim"])
-            dropped = rec["services"]["mft-record"]["dropped_samples"]
-            if dropped:
-                progress(f"  warning: the recorder dropped {dropped} samples")
-        sim_s = plain[0]["sim_time_s"]
-        wall_plain = [s["wall_time_s"] for s in plain]
+
+def median(values):
+    return round(statistics.median(values), 4) if values else None
+
+
+def measure(args, tmp):
+    variants = parse_variants(args.variant, args.chain_cpu)
+    out = {"cpus": os.cpu_count(), "allowed_cpus": sorted(os.sched_getaffinity(0)), "scenario": str(args.scenario),
+           "rounds": args.runs, "load_average_before": load_average(), "load_averages_per_round": []}
+    if os.getloadavg()[0] > 0.5 * (os.cpu_count() or 1):
+        progress(f"measure-stack: warning: load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cpus: other jobs "
+                 "slow the in-process reference and the stack unevenly, so the ratio is not a figure to quote")
+    inprocess = []
+    plain = {label: [] for label, _ in variants}
+    recorded = []
+    for i in range(args.runs):
+        progress(f"round {i + 1}/{args.runs} (load {os.getloadavg()[0]:.2f}): in-process, "
+                 + ", ".join(f"lockstep {label}" for label, _ in variants)
+                 + ("" if args.skip_recording else ", lockstep recording") + " ...")
+        out["load_averages_per_round"].append(round(os.getloadavg()[0], 2))
+        inprocess.append(run_inprocess(args))
+        for label, extra in variants:
+            plain[label].append(run_stack(args, tmp, args.scenario, "lockstep", f"{label}-{i}", extra, hops=not args.no_hops))
+        if not args.skip_recording:
+            s = run_stack(args, tmp, args.scenario, "lockstep", f"rec-{i}", variants[0][1], record=True)
+            recorded.append(s)
+            if s.get("recorder_dropped_samples"):
+                progress(f"  warning: the recorder dropped {s['recorder_dropped_samples']} samples")
+    sim_s = inprocess[0]["sim_time_s"]
+    wall_in = [s["wall_time_s"] for s in inprocess]
+    out["inprocess"] = {"sim_s": sim_s, "wall_s": wall_in, "real_time_factor_median": round(sim_s / statistics.median(wall_in), 2),
+                        "us_per_tick_median": round(statistics.median(wall_in) / inprocess[0]["ticks"] * 1e6, 1)}
+    out["lockstep"] = {}
+    for label, extra in variants:
+        runs = plain[label]
+        wall = [s["wall_time_s"] for s in runs]
+        ratios = [round(w_in / w, 4) for w_in, w in zip(wall_in, wall)]  # speed ratio = in-process wall / lockstep wall
+        v = {"supervisor_options": extra, "sim_s": runs[0]["sim_time_s"], "wall_s": wall,
+             "real_time_factor_median": round(runs[0]["sim_time_s"] / statistics.median(wall), 2),
+             "us_per_tick_median": round(statistics.median(wall) / max(1, runs[0]["ticks"]) * 1e6, 1),
+             "ratio_to_inprocess_per_round": ratios, "ratio_to_inprocess_median": median(ratios),
+             "resends": sum(s.get("lockstep_resends", 0) for s in runs), "chain_cpu": [s["run_chain_cpu"] for s in runs]}
+        if not args.no_hops:  # the table of the run with the median wall time
+            v["hop_table"] = sorted(runs, key=lambda s: s["wall_time_s"])[len(runs) // 2]["hop_table"]
+        out["lockstep"][label] = v
+    if recorded:
+        base = plain[variants[0][0]]
         wall_rec = [s["wall_time_s"] for s in recorded]
-        out["lockstep"] = {
-            "sim_s": sim_s,
-            "wall_s_plain": wall_plain,
-            "wall_s_recording": wall_rec,
-            "real_time_factor_median": round(sim_s / statistics.median(wall_plain), 2),
-            "real_time_factor_best": round(sim_s / min(wall_plain), 2),
-            "recording_real_time_factor_median": round(sim_s / statistics.median(wall_rec), 2),
-            "recording_slowdown_median": round(statistics.median(wall_rec) / statistics.median(wall_plain), 3),
-            "recording_slowdown_best": round(min(wall_rec) / min(wall_plain), 3),
-            # Each recorded run against the plain run just before it: the machine's drift cancels.
-            "recording_slowdown_paired": sorted(round(r / p, 3) for r, p in zip(wall_rec, wall_plain)),
-            "resends": sum(s.get("lockstep_resends", 0) for s in plain + recorded),
-        }
-        if args.hops:  # the table of the plain run with the median wall time
-            median_run = sorted(plain, key=lambda s: s["wall_time_s"])[len(plain) // 2]
-            out["lockstep"]["hop_table"] = median_run["hop_table"]
-        if not args.skip_realtime:
-            scenario = Path(tmp) / "step-in-place-long.yaml"
-            text = SCENARIO.read_text().replace("duration_s: 10.0", f"duration_s: {args.realtime_s}")
-            scenario.write_text(text.replace("name: step-in-place", "name: step-in-place-long"))
-            progress(f"realtime run of {args.realtime_s:g} s ...")
-            s = run_stack(args, tmp, scenario, "realtime", tag="rt")
-            out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["deadline_misses"],
-                               "sensor_to_command_latency_us": s["sensor_to_command_latency_us"],
-                               "wbc_tick_us": s["wbc_tick_us"], "fell": s["fell"]}
-    out["load_per_core_after"] = round(os.getloadavg()[0] / (os.cpu_count() or 1), 2)
+        out["recording"] = {
+            "variant": variants[0][0], "wall_s": wall_rec,
+            # Each recorded run against the plain run of the same round: the machine's drift cancels.
+            "slowdown_per_round": [round(r / p["wall_time_s"], 3) for r, p in zip(wall_rec, base)],
+            "resends": sum(s.get("lockstep_resends", 0) for s in recorded),
+            "dropped_samples": sum(s.get("recorder_dropped_samples") or 0 for s in recorded)}
+        out["recording"]["slowdown_median"] = median(out["recording"]["slowdown_per_round"])
+    if not args.skip_realtime:
+        scenario = Path(tmp) / "step-in-place-long.yaml"
+        text = Path(args.scenario).read_text().replace("duration_s: 10.0", f"duration_s: {args.realtime_s}")
+        scenario.write_text(text.replace("name: step-in-place", "name: step-in-place-long"))
+        progress(f"realtime run of {args.realtime_s:g} s (load {os.getloadavg()[0]:.2f}) ...")
+        extra = variants[0][1] + (["--stall-probe"] if args.stall_probe else [])
+        s = run_stack(args, tmp, scenario, "realtime", "rt", extra, timeout_s=args.realtime_s + 300)
+        out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["run_deadline_misses"],
+                           "sensor_to_command_latency_us": s["run_sensor_to_command_latency_us"],
+                           "wbc_tick_us": s["run_wbc_tick_us"], "fell": s["fell"], "chain_cpu": s["run_chain_cpu"],
+                           "sim_wakeup_late_us": s.get("sim_wakeup_late_us"),
+                           # the simulator's watchdog misses (a tick > 3 ms without its command), and with
+                           # --stall-probe which of them fell in a stall of the machine
+                           "sim_deadline_misses": s.get("deadline_misses"),
+                           "sim_misses_during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
+                           "sim_misses_unexplained": s.get("deadline_misses_unexplained")}
+    if not args.skip_wakeup:
+        out["machine_wakeup"] = run_wakeup_probe(args)
+    out["load_average_after"] = load_average()
+    return out
 
-    if args.json:
-        print(json.dumps(out, indent=1))
-        return
-    ls = out["lockstep"]
-    print(f"machine: {out['cpus']} cpus, load per core {out['load_per_core_before']} before, "
-          f"{out['load_per_core_after']} after")
-    print(f"lockstep, {ls['sim_s']:g} s step in place: sim loop wall {statistics.median(ls['wall_s_plain']):.3f} s "
-          f"median -> {ls['real_time_factor_median']}x real time (best {ls['real_time_factor_best']}x)")
-    print(f"  recording every topic: {statistics.median(ls['wall_s_recording']):.3f} s median -> "
-          f"{ls['recording_real_time_factor_median']}x real time, slowdown x{ls['recording_slowdown_median']} "
-          f"(best x{ls['recording_slowdown_best']}, paired median x{statistics.median(ls['recording_slowdown_paired']):.3f}); "
-          f"tick re-sends {ls['resends']}")
-    if "hop_table" in ls:
-        print("per-hop table of the median plain lockstep run [us]:")
-        hop_table_module().print_table(ls["hop_table"])
+
+def run_wakeup_probe(args):
+    """The machine's own floor (mft-wakeup --rt, SCHED_FIFO as the realtime stack when permitted): 1 kHz timer
+    lateness per CPU, thread wake-ups on one core and across cores."""
+    exe = Path(args.bin_dir) / "mft-wakeup"
+    if not exe.exists():
+        raise MeasureError(f"no mft-wakeup in {args.bin_dir} (build it, or pass --skip-wakeup)")
+    progress(f"machine wake-up probe (load {os.getloadavg()[0]:.2f}) ...")
+    try:
+        p = subprocess.run([str(exe), "--json", "--rt"], capture_output=True, text=True, timeout=120)
+        return json.loads(p.stdout)
+    except subprocess.TimeoutExpired:
+        raise MeasureError("mft-wakeup did not finish within 120 s")
+    except ValueError:
+        raise MeasureError(f"mft-wakeup gave no figures (exit {p.returncode}): {p.stderr.strip()[-300:]}")
+
+
+def print_report(out):
+    hop_table = hop_table_module()
+    lb, la = out["load_average_before"], out["load_average_after"]
+    print(f"machine: {out['cpus']} cpus (allowed {out['allowed_cpus']}); load average before {lb['1min']} "
+          f"{lb['5min']} {lb['15min']}, after {la['1min']} {la['5min']} {la['15min']}; per round "
+          f"{out['load_averages_per_round']}")
+    ip = out["inprocess"]
+    print(f"in-process (mft-closedloop), {ip['sim_s']:g} s: wall {statistics.median(ip['wall_s']):.3f} s median "
+          f"-> {ip['real_time_factor_median']}x real time, {ip['us_per_tick_median']} us per tick")
+    for label, v in out["lockstep"].items():
+        print(f"lockstep [{label}] {' '.join(v['supervisor_options']) or '(defaults)'}: wall "
+              f"{statistics.median(v['wall_s']):.3f} s median -> {v['real_time_factor_median']}x real time, "
+              f"{v['us_per_tick_median']} us per tick; ratio to in-process {v['ratio_to_inprocess_median']} median "
+              f"(per round {v['ratio_to_inprocess_per_round']}); tick re-sends {v['resends']}")
+        if "hop_table" in v:
+            print(f"  per-hop table of its median run [us]:")
+            hop_table.print_table(v["hop_table"])
+    if "recording" in out:
+        r = out["recording"]
+        print(f"recording every topic [{r['variant']}]: slowdown x{r['slowdown_median']} median (per round "
+              f"{r['slowdown_per_round']}); re-sends {r['resends']}, dropped samples {r['dropped_samples']}")
     if "realtime" in out:
         rt = out["realtime"]
         lat = rt["sensor_to_command_latency_us"]
         print(f"realtime, {rt['sim_s']:g} s: sensor-to-command latency p50 {lat['p50']:.0f} us, p99 {lat['p99']:.0f} us, "
-              f"max {lat['max']:.0f} us over {lat['count']} ticks; deadline misses {rt['deadline_misses']}; "
-              f"WBC tick p50 {rt['wbc_tick_us']['p50']:.1f} us, p99 {rt['wbc_tick_us']['p99']:.1f} us")
+              f"max {lat['max']:.0f} us over {lat['count']} ticks; deadline misses {rt['deadline_misses']} (readers and "
+              f"simulator), of the simulator {rt['sim_deadline_misses']}"
+              + (f": {rt['sim_misses_during_cpu_stalls']} during CPU stalls, {rt['sim_misses_unexplained']} unexplained"
+                 if rt.get("sim_misses_unexplained") is not None else ""))
+    if "machine_wakeup" in out:
+        w = out["machine_wakeup"]
+        timers = ", ".join(f"{cpu} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}" for cpu, t in w["timer_late_us"].items())
+        wake = ", ".join(f"{where.replace('_', ' ')} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}"
+                         for where, t in w["wakeup_us"].items())
+        print(f"machine wake-up floor (mft-wakeup, {w['scheduling']}) [us]: 1 kHz timer late: {timers}; "
+              f"thread wake-up: {wake}")
+
+
+def reexec_in_private_net():
+    """Runs this script again inside `unshare -n` with the loopback up; returns its exit status."""
+    if not shutil.which("unshare") or not shutil.which("ip"):
+        raise MeasureError("--private-net needs unshare and ip (util-linux, iproute2)")
+    argv = [a for a in sys.argv[1:] if a != "--private-net"]
+    env = dict(os.environ, **{NETNS_ENV: "1"})
+    cmd = ["unshare", "-n", "sh", "-c", 'ip link set lo up && exec "$@"', "sh", sys.executable, str(Path(__file__).resolve())] + argv
+    p = subprocess.run(cmd, env=env)
+    if p.returncode != 0 and p.returncode not in (1, 2, 130):
+        progress(f"measure-stack: the run in a private network namespace ended with status {p.returncode} "
+                 "(unshare -n needs root or user namespaces)")
+    return p.returncode
+
+
+def main():
+    ap = argparse.ArgumentParser(prog="measure-stack.py", description=__doc__.split("\n\n")[0],
+                                 epilog=__doc__.split("\n\n", 1)[1], formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables")
+    ap.add_argument("--scenario", default=str(SCENARIO), help="scenario (default config/scenarios/step-in-place.yaml)")
+    ap.add_argument("--domain", type=int, default=71, help="DDS domain id for the runs (default 71)")
+    ap.add_argument("--runs", type=int, default=3, help="rounds (in-process, lockstep per variant, recorded; default 3)")
+    ap.add_argument("--realtime-s", type=float, default=60.0, help="length of the realtime run [s] (default 60)")
+    ap.add_argument("--chain-cpu", metavar="N|auto|none", help="pass --chain-cpu to the supervisor in every variant")
+    ap.add_argument("--variant", action="append", metavar="LABEL=OPTIONS", help="a lockstep variant: extra supervisor "
+                    "options (repeatable; each round runs every variant once, interleaved)")
+    ap.add_argument("--skip-realtime", action="store_true", help="lockstep figures only")
+    ap.add_argument("--skip-recording", action="store_true", help="no recorded runs")
+    ap.add_argument("--stall-probe", action="store_true", help="realtime run with the simulator's CPU stall probe: "
+                    "each deadline miss attributed to a stall of the machine or to the chain (costs ~30 us of p50)")
+    ap.add_argument("--skip-wakeup", action="store_true", help="no machine wake-up probe (mft-wakeup)")
+    ap.add_argument("--no-hops", action="store_true", help="do not trace the plain lockstep runs hop by hop")
+    ap.add_argument("--hops", action="store_true", help=argparse.SUPPRESS)  # the default now; kept for old commands
+    ap.add_argument("--private-net", action="store_true", help="run inside a private network namespace (unshare -n)")
+    ap.add_argument("--json", action="store_true", help="print the figures as JSON")
+    args = ap.parse_args()
+    for exe in ("mft-sim", "mft-closedloop"):
+        if not (Path(args.bin_dir) / exe).exists():
+            print(f"measure-stack.py: error: no {exe} in {args.bin_dir} (build first: bash scripts/build.sh release)",
+                  file=sys.stderr)
+            return 2
+    if not Path(args.scenario).is_file():
+        print(f"measure-stack.py: error: no scenario file {args.scenario}", file=sys.stderr)
+        return 2
+    if args.runs < 1 or args.realtime_s < 1 or not 0 <= args.domain <= 232:
+        print("measure-stack.py: error: --runs and --realtime-s must be at least 1, --domain 0..232", file=sys.stderr)
+        return 2
+    try:
+        if args.private_net and not os.environ.get(NETNS_ENV):
+            return reexec_in_private_net()
+        with tempfile.TemporaryDirectory(prefix="mft-measure-") as tmp:
+            out = measure(args, tmp)
+    except MeasureError as e:
+        print(f"measure-stack.py: error: {e}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(out, indent=1))
+    else:
+        print_report(out)
+    return 0
 
 
 if __name__ == "__main__":

@@ -342,9 +342,11 @@ def main(argv=None):
         sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
                         "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
                         "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
-        sp.add_argument("--chain-cpu", type=int, metavar="N", help="pin the control chain (sim, estimator, planner, wbc) "
-                        "to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
-                        "(lockstep: faster, and recording costs less; docs/benchmarks.md 'Loop benchmark')")
+        sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
+                        "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
+                        "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "
+                        "lockstep stack on the CPU its domain picks (domain modulo the CPUs allowed), realtime and "
+                        "--stack unpinned; none: no pinning")
         sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
                         "identities in DIR (scripts/make-security.sh; docs/security.md)")
         sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "

@@ -42,19 +42,48 @@ def _set_pdeathsig():
     libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
 
-def cpu_placement(chain_cpu, names):
-    """--chain-cpu N: the control chain on CPU N, the recorder on the others.
+def chain_cpu_for(chain_cpu, mode, domain, multi_host):
+    """The CPU the control chain is pinned to, or None: --chain-cpu N, "none" (no pinning) or "auto" (the
+    default when the option is not given).
 
     A lockstep tick is a relay (sim -> estimator -> planner -> wbc -> sim) in which one process runs at a time:
     on one core every hand-off is a local wake-up, while a wake-up on another, idle, vCPU costs tens of us on
-    a VM. The recorder then works on the other cores without taking the chain's core."""
+    a VM (docs/loop-benchmark.md). "auto" pins a lockstep stack to one of the CPUs this process may use, chosen
+    by its DDS domain, so that the stacks of mft-experiment's local workers (consecutive domains) each get
+    their own core; realtime stacks and multi-host stacks (--stack) are not pinned by "auto". Measured
+    (docs/loop-benchmark.md, interleaved A/B under load): the pinned chain ran a lockstep tick in ~0.7x the time
+    of the unpinned one."""
+    if chain_cpu is None:
+        chain_cpu = "auto"
+    if chain_cpu == "none":
+        return None
+    allowed = sorted(os.sched_getaffinity(0))
+    if chain_cpu == "auto":
+        if mode != "lockstep" or multi_host:
+            return None
+        return allowed[domain % len(allowed)]
+    try:
+        cpu = int(chain_cpu)
+    except (TypeError, ValueError):
+        raise SupervisorError(f"--chain-cpu {chain_cpu}: expected a CPU number, auto or none")
+    if cpu not in allowed:
+        raise SupervisorError(f"--chain-cpu {chain_cpu}: this process may run on CPUs {allowed} only")
+    return cpu
+
+
+def cpu_placement(chain_cpu, names, recorder_elsewhere=True):
+    """The chain (sim, estimator, planner, wbc) on CPU `chain_cpu` (None: no pinning); the recorder on the other
+    CPUs when `recorder_elsewhere` (an explicit --chain-cpu N), else free. "auto" leaves it free: the lockstep
+    recorder's threads are SCHED_IDLE, and confined to a core that something else keeps busy (another stack's
+    chain in mft-experiment, another job) it starved until the simulator's recorder window timed out (measured:
+    rawlog_integration's starved-recorder run on a loaded machine); free, it also takes the chain's core
+    whenever the chain waits for it."""
     if chain_cpu is None:
         return {}
     allowed = sorted(os.sched_getaffinity(0))
-    if chain_cpu not in allowed:
-        raise SupervisorError(f"--chain-cpu {chain_cpu}: this process may run on CPUs {allowed} only")
     others = [c for c in allowed if c != chain_cpu] or [chain_cpu]
-    return {n: ({chain_cpu} if n in CORE_SERVICES + ["mft-sim"] else set(others)) for n in names}
+    return {n: {chain_cpu} if n in CORE_SERVICES + ["mft-sim"] else set(others)
+            for n in names if n in CORE_SERVICES + ["mft-sim"] or recorder_elsewhere}
 
 
 class Service:
@@ -165,7 +194,9 @@ class Stack:
             argv = self.stack.launcher(host) + [self.stack.server_exe, "-x", str(profiles[DISCOVERY_SERVER])]
             self.services[DISCOVERY_SERVER] = Service(DISCOVERY_SERVER, argv, self.run_dir, summary=False,
                                                       ready_line=DISCOVERY_SERVER_READY, host=host)
-        placement = cpu_placement(getattr(args, "chain_cpu", None), names)
+        self.chain_cpu = chain_cpu_for(getattr(args, "chain_cpu", None), args.mode, args.domain, bool(self.stack))
+        explicit = getattr(args, "chain_cpu", None) not in (None, "auto", "none")
+        placement = cpu_placement(self.chain_cpu, names, recorder_elsewhere=explicit)
         for name in names:
             argv = [str(Path(args.bin_dir) / name)] + common
             host = None

@@ -41,6 +41,9 @@ class StackTest(StackTestCase):
             self.assertEqual(svc["last_tick"], 9999, name)    # on the simulator's clock
         self.assertEqual(s["services"]["mft-wbc"]["non_optimal_solves"], 0)
         self.assertEqual(s["wbc_safety_events"], 0)
+        # Lockstep: the chain ran on the one CPU its domain picks (docs/loop-benchmark.md).
+        allowed = sorted(os.sched_getaffinity(0))
+        self.assertEqual(s["chain_cpu"], allowed[DOMAIN_BASE % len(allowed)])
         sim = s["services"]["mft-sim"]
         self.assertLess(sim["max_closure_error_m"], 1e-5)
         self.assertGreater(sim["touchdowns"][0], 5)          # it really steps
@@ -66,6 +69,7 @@ class StackTest(StackTestCase):
         self.assertFalse(s["fell"], sim.get("fall_reason"))
         self.assertEqual(s["ticks"], 10000)
         self.assertGreater(s["wall_time_s"], 9.9)             # it ran on the wall clock
+        self.assertIsNone(s["chain_cpu"])                     # realtime: not pinned by default
         self.assertGreater(sim["latency_us"]["count"], 9000)  # nearly every command answered within its period
         print(f"\nrealtime: deadline misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, "
               f"latency p50 {sim['latency_us']['p50']:.0f} us p99 {sim['latency_us']['p99']:.0f} us, simulator "

@@ -15,6 +15,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import HELPER_FIFO_PRIORITY, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
+from mftstack.errors import SupervisorError  # noqa: E402
+from mftstack.processes import chain_cpu_for, cpu_placement  # noqa: E402
 from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -64,6 +66,32 @@ class FakeStack:
         self.procs.append(p)
         out, err = p.communicate(timeout=timeout)
         return p.returncode, out, err
+
+
+class ChainPlacementTest(unittest.TestCase):
+    """--chain-cpu: auto (the default) pins a lockstep stack to the CPU its domain picks, so that consecutive
+    domains (mft-experiment's local workers) get different cores; realtime and multi-host stacks stay free."""
+
+    def test_auto_none_and_explicit(self):
+        allowed = sorted(os.sched_getaffinity(0))
+        for domain in range(4):
+            self.assertEqual(chain_cpu_for(None, "lockstep", domain, False), allowed[domain % len(allowed)])
+            self.assertEqual(chain_cpu_for("auto", "lockstep", domain, False), allowed[domain % len(allowed)])
+        if len(allowed) > 1:
+            self.assertNotEqual(chain_cpu_for("auto", "lockstep", 20, False), chain_cpu_for("auto", "lockstep", 21, False))
+        self.assertIsNone(chain_cpu_for("auto", "realtime", 3, False))
+        self.assertIsNone(chain_cpu_for(None, "lockstep", 3, True))
+        self.assertIsNone(chain_cpu_for("none", "lockstep", 3, False))
+        self.assertEqual(chain_cpu_for(str(allowed[-1]), "realtime", 3, False), allowed[-1])
+        with self.assertRaisesRegex(SupervisorError, "expected a CPU number, auto or none"):
+            chain_cpu_for("x", "lockstep", 3, False)
+        placement = cpu_placement(allowed[0], ["mft-wbc", "mft-sim", "mft-record"])
+        self.assertEqual(placement["mft-wbc"], {allowed[0]})
+        self.assertEqual(placement["mft-sim"], {allowed[0]})
+        self.assertEqual(placement["mft-record"], set(allowed[1:]) or {allowed[0]})
+        self.assertEqual(cpu_placement(None, ["mft-wbc"]), {})
+        auto = cpu_placement(allowed[0], ["mft-wbc", "mft-sim", "mft-record"], recorder_elsewhere=False)
+        self.assertEqual(auto, {"mft-wbc": {allowed[0]}, "mft-sim": {allowed[0]}})  # the recorder stays free
 
 
 class SupervisorTest(FakeStack, unittest.TestCase):
@@ -236,12 +264,23 @@ class SupervisorTest(FakeStack, unittest.TestCase):
             subprocess.run(base + ["down", "--domain", "13"], env=env, capture_output=True, text=True, timeout=60)
         self.assertFalse(any(pid_alive(p) for p in self.started_pids()))
 
+    def test_a_lockstep_run_pins_its_chain_by_default_to_the_cpu_its_domain_picks(self):
+        allowed = sorted(os.sched_getaffinity(0))
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "9", "--json", fake="mft-sim:run_for=0.3")
+        self.assertEqual(code, 0, err)
+        self.assertEqual(json.loads(out)["chain_cpu"], allowed[9 % len(allowed)])
+        code, out, err = self.supervisor("run", str(self.scenario), "--domain", "9", "--json", "--chain-cpu", "none",
+                                         fake="mft-sim:run_for=0.3")
+        self.assertEqual(code, 0, err)
+        self.assertIsNone(json.loads(out)["chain_cpu"])
+
     def test_bad_inputs_start_nothing(self):
         cases = [
             (["run", str(self.scenario), "--domain", "500"], "bad domain id 500"),
             (["run", str(self.tmp / "missing.yaml"), "--domain", "12"], "does not exist"),
             (["run", str(self.scenario), "--domain", "12", "--mode", "fast"], "bad mode 'fast'"),
             (["run", str(self.scenario), "--domain", "12", "--chain-cpu", "4096"], "--chain-cpu 4096: this process may run"),
+            (["run", str(self.scenario), "--domain", "12", "--chain-cpu", "fast"], "--chain-cpu fast: expected a CPU number"),
         ]
         for args, expect in cases:
             code, out, err = self.supervisor(*args)

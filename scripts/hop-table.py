@@ -16,14 +16,14 @@ from pathlib import Path
 SERVICES = ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc")
 # (name, from (service, mark), to (service, mark), to on the next tick): consecutive, so they add up to the tick.
 INTERVALS = [
-    ("sim writes SensorData (then GroundTruth) -> estimator has it", ("mft-sim", "publish"), ("mft-estimator", "sensor_in"), False),
+    ("sim writes SensorData and GroundTruth -> estimator has it", ("mft-sim", "publish"), ("mft-estimator", "sensor_in"), False),
     ("estimator compute", ("mft-estimator", "sensor_in"), ("mft-estimator", "write"), False),
     ("estimator writes RobotState -> planner has it", ("mft-estimator", "write"), ("mft-planner", "state_in"), False),
     ("planner compute", ("mft-planner", "state_in"), ("mft-planner", "write"), False),
     ("planner writes Reference -> WBC starts (holds both inputs)", ("mft-planner", "write"), ("mft-wbc", "compute"), False),
     ("WBC compute", ("mft-wbc", "compute"), ("mft-wbc", "write"), False),
-    ("WBC writes JointCommand -> sim's listener has it", ("mft-wbc", "write"), ("mft-sim", "command_in"), False),
-    ("sim listener -> sim loop thread (hand-off)", ("mft-sim", "command_in"), ("mft-sim", "wake"), False),
+    ("WBC writes JointCommand -> sim has it", ("mft-wbc", "write"), ("mft-sim", "command_in"), False),
+    ("sim reader -> sim loop thread (hand-off; none on the chain channel)", ("mft-sim", "command_in"), ("mft-sim", "wake"), False),
     ("sim physics step", ("mft-sim", "wake"), ("mft-sim", "stepped"), False),
     ("sim bookkeeping, message conversion", ("mft-sim", "stepped"), ("mft-sim", "publish"), True),
 ]

@@ -71,6 +71,16 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
     return cpu
 
 
+def chain_shm_name(args, multi_host):
+    """The shared-memory segment of this stack's lockstep chain (--chain-transport shm, the default), or None:
+    realtime keeps DDS (a restarted peer must rejoin), --secure must not bypass access control, and --stack puts
+    the services on different hosts."""
+    if args.mode != "lockstep" or getattr(args, "chain_transport", "shm") != "shm" or multi_host \
+            or getattr(args, "secure", None):
+        return None
+    return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
+
+
 def cpu_placement(chain_cpu, names, recorder_elsewhere=True):
     """The chain (sim, estimator, planner, wbc) on CPU `chain_cpu` (None: no pinning); the recorder on the other
     CPUs when `recorder_elsewhere` (an explicit --chain-cpu N), else free. "auto" leaves it free: the lockstep
@@ -194,6 +204,7 @@ class Stack:
             argv = self.stack.launcher(host) + [self.stack.server_exe, "-x", str(profiles[DISCOVERY_SERVER])]
             self.services[DISCOVERY_SERVER] = Service(DISCOVERY_SERVER, argv, self.run_dir, summary=False,
                                                       ready_line=DISCOVERY_SERVER_READY, host=host)
+        self.chain_shm = chain_shm_name(args, bool(self.stack))
         self.chain_cpu = chain_cpu_for(getattr(args, "chain_cpu", None), args.mode, args.domain, bool(self.stack))
         explicit = getattr(args, "chain_cpu", None) not in (None, "auto", "none")
         placement = cpu_placement(self.chain_cpu, names, recorder_elsewhere=explicit)
@@ -203,6 +214,8 @@ class Stack:
             if self.stack:
                 host = self.stack.placement[name]
                 argv = self.stack.launcher(host) + argv + ["--profiles", str(profiles[host])]
+            if self.chain_shm and name in CORE_SERVICES + ["mft-sim"]:
+                argv += ["--chain-shm", self.chain_shm]
             if name == "mft-record":
                 argv += ["--output", str(Path(args.record).resolve())] + (["--overwrite"] if args.overwrite else [])
             if name == "mft-sim" and getattr(args, "record", None) and args.mode == "lockstep" and RECORDER_WINDOW_TICKS:
@@ -298,6 +311,12 @@ class Stack:
                 svc.signal(signal.SIGKILL)
                 svc.wait(2.0)
                 self.events.append({"service": name, "event": "killed after grace period", "time": time.time()})
+
+        if self.chain_shm:  # mft-sim unlinks it once the chain is attached; this covers a stack that never got there
+            try:
+                os.unlink("/dev/shm" + self.chain_shm)
+            except OSError:
+                pass
 
     def pids(self):
         return {n: s.proc.pid for n, s in self.services.items() if s.proc is not None}

@@ -33,6 +33,7 @@ def build_summary(stack, wall_s, error):
         "profiles": stack.scenario.get("profiles", []),
         "run_dir": str(stack.run_dir), "ok": error is None and not stack.failed, "error": error,
         "secure": bool(getattr(stack.args, "secure", None)), "chain_cpu": getattr(stack, "chain_cpu", None),
+        "chain_transport": "shm" if getattr(stack, "chain_shm", None) else "dds",
         "stack": dict(stack.stack.describe(), services=stack.hosts(), only_host=stack.only_host) if stack.stack else None,
         "fell": sim.get("fell"), "sim_time_s": sim.get("sim_time_s"), "wall_time_s": round(wall_s, 3),
         "ticks": sim.get("ticks"), "real_time_factor": None,

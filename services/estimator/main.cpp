@@ -62,8 +62,19 @@ static int toolMain(int argc, char** argv) {
     hops.mark(2, sensors.tick);
     join.answered(sensors.tick);
   };
+  // On the chain channel the simulator writes GroundTruth(k) before SensorData(k): the sensor sample takes it first,
+  // so the estimator is woken once per tick (with DDS, the truth comes on its own).
+  services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
+      ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!join.accept(services::validInput(m), "GroundTruth", m.tick())) return;
+        services::fromMsg(m, &truth);
+        have_truth = true;
+        process(false);
+      }, services::ChainSlotReader::Delivery::Polled);
   services::TopicReader<msg::SensorData, msg::SensorDataPubSubType> sensor_reader(
       ctx.participant(), "SensorData", ctx.chainReaderProfile(), [&](const msg::SensorData& m) {
+        truth_reader.pollChannel();
         hops.mark(0, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         bool new_clock = false;  // a NaN would stay in the filter for good
@@ -73,15 +84,6 @@ static int toolMain(int argc, char** argv) {
         have_sensors = true;
         process(true);
       });
-  services::TopicReader<msg::GroundTruth, msg::GroundTruthPubSubType> truth_reader(
-      ctx.participant(), "GroundTruth", ctx.chainReaderProfile(), [&](const msg::GroundTruth& m) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!join.accept(services::validInput(m), "GroundTruth", m.tick())) return;
-        services::fromMsg(m, &truth);
-        have_truth = true;
-        process(false);
-      });
-
   services::announceReady("mft-estimator");
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 

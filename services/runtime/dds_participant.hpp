@@ -8,10 +8,12 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "services/runtime/chain_channel.hpp"
 #include "services/runtime/dds_security.hpp"
 #include "services/runtime/polling_udp_transport.hpp"
 
@@ -24,6 +26,11 @@ class DdsError : public std::runtime_error {
 
 // Highest domain id usable with the default UDP port mapping of Fast DDS (PB 7400 + DG 250 * domain < 65536).
 constexpr int kMaxDomainId = 232;
+
+// The QoS profiles of the lockstep chain (ServiceContext::chainWriterProfile/chainReaderProfile); the chain
+// channel carries only the topics written and read with these.
+inline constexpr const char* kLockstepWriterProfile = "lockstep_writer";
+inline constexpr const char* kLockstepReaderProfile = "lockstep_reader";
 
 // Validates a domain id, throwing DdsError with a message that names the valid range.
 int checkedDomainId(long domain_id);
@@ -53,6 +60,10 @@ class DdsParticipant {
   eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
   eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
   int domainId() const { return domain_id_; }
+  // Lockstep chain services only: the shared-memory channel their chain topics also travel by
+  // (chain_channel.hpp). TopicWriter/TopicReader with the lockstep profiles use it when it is open.
+  void openChainChannel(const std::string& name) { chain_channel_ = std::make_unique<ChainChannel>(name); }
+  ChainChannel* chainChannel() const { return chain_channel_.get(); }
 
  private:
   int domain_id_;
@@ -61,6 +72,7 @@ class DdsParticipant {
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, eprosima::fastdds::dds::TypeSupport> types_;
+  std::unique_ptr<ChainChannel> chain_channel_;
 };
 
 }  // namespace mft::services

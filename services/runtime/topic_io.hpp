@@ -2,6 +2,10 @@
 // Typed topic writers and readers on a DdsParticipant, created from a named QoS profile.
 // The reader delivers every valid sample to a callback on the DDS receive thread (the cheapest path at
 // 1 kHz, docs/dds.md#transport-and-qos) and counts deadline misses, liveliness changes and matched writers.
+// In a lockstep chain service whose participant has the chain channel open (chain_channel.hpp), the chain topics
+// with the lockstep profiles go through shared memory: the writer also puts each sample in the topic's slot, and
+// the reader takes them from there only (no DDS reader: a second copy would wake it twice).
+#include <fastdds/rtps/common/SerializedPayload.h>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
@@ -10,7 +14,9 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstring>
 #include <functional>
+#include <memory>
 #include <thread>
 
 #include "services/runtime/dds_participant.hpp"
@@ -25,6 +31,12 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
     writer_ = p.publisher()->create_datawriter_with_profile(topic, profile, this);
     if (!writer_) throw DdsError("cannot create a writer on " + topic_name + " with profile " + profile);
     publisher_ = p.publisher();
+    const int slot = chainSlotIndex(topic_name);
+    if (p.chainChannel() && profile == kLockstepWriterProfile && slot >= 0) {
+      if (type_.m_typeSize > ChainChannel::kSlotBytes) throw DdsError(topic_name + " does not fit a chain channel slot");
+      payload_.reserve(type_.m_typeSize);
+      shm_ = std::make_unique<ChainSlotWriter>(*p.chainChannel(), slot);
+    }
   }
   ~TopicWriter() override {
     if (writer_) publisher_->delete_datawriter(writer_);
@@ -32,7 +44,16 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   TopicWriter(const TopicWriter&) = delete;
   TopicWriter& operator=(const TopicWriter&) = delete;
 
-  bool write(const Msg& msg) { return writer_->write(const_cast<Msg*>(&msg)); }
+  bool write(const Msg& msg) {
+    if (shm_) {  // the chain first: its reader runs while this process still hands the sample to DDS
+      payload_.length = 0;
+      payload_.pos = 0;
+      if (!type_.serialize(const_cast<Msg*>(&msg), &payload_)) return false;
+      shm_->write(payload_.data, payload_.length);
+      if (matched_.load() == 0) return true;  // best effort, volatile: a DDS write nobody matched delivers nothing
+    }
+    return writer_->write(const_cast<Msg*>(&msg));
+  }
   // Reliable writers: waits until every matched reader has acknowledged every sample written so far.
   bool waitForAcknowledgments(std::chrono::milliseconds timeout) {
     const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(timeout).count();
@@ -40,7 +61,8 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
                                                                             static_cast<std::uint32_t>(ns % 1000000000))) ==
            eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
   }
-  int matched() const { return matched_.load(); }
+  int matched() const { return matched_.load() + (shm_ ? shm_->readers() : 0); }
+  bool viaChainChannel() const { return shm_ != nullptr; }
   std::uint64_t offeredDeadlineMisses() const { return offered_deadline_misses_.load(); }
 
   void on_publication_matched(eprosima::fastdds::dds::DataWriter*,
@@ -57,29 +79,50 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
   std::atomic<int> matched_{0};
   std::atomic<std::uint64_t> offered_deadline_misses_{0};
+  PubSubType type_;  // serializes into the chain channel's slot
+  eprosima::fastrtps::rtps::SerializedPayload_t payload_;
+  std::unique_ptr<ChainSlotWriter> shm_;
 };
 
 template <class Msg, class PubSubType>
 class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
  public:
   using Callback = std::function<void(const Msg&)>;
-  TopicReader(DdsParticipant& p, const std::string& topic_name, const std::string& profile, Callback on_sample)
+  // `delivery` matters only on the chain channel: Polled means this reader's thread is never woken for the topic;
+  // the owner calls pollChannel() / awaitChannel() (DDS delivers on its own thread as always).
+  TopicReader(DdsParticipant& p, const std::string& topic_name, const std::string& profile, Callback on_sample,
+              ChainSlotReader::Delivery delivery = ChainSlotReader::Delivery::Woken)
       : on_sample_(std::move(on_sample)) {
     auto* topic = p.topic(topic_name, new PubSubType());
     subscriber_ = p.subscriber();
+    const int slot = chainSlotIndex(topic_name);
+    if (p.chainChannel() && profile == kLockstepReaderProfile && slot >= 0) {
+      payload_.reserve(type_.m_typeSize);
+      shm_ = std::make_unique<ChainSlotReader>(*p.chainChannel(), slot,
+                                               [this](const unsigned char* bytes, std::size_t size) { onBytes(bytes, size); },
+                                               delivery);
+      return;
+    }
     reader_ = subscriber_->create_datareader_with_profile(topic, profile, this);
     if (!reader_) throw DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
   }
   ~TopicReader() override {
+    shm_.reset();  // joins its thread before the callback's captures go
     if (reader_) subscriber_->delete_datareader(reader_);
   }
   TopicReader(const TopicReader&) = delete;
   TopicReader& operator=(const TopicReader&) = delete;
 
-  int matched() const { return matched_.load(); }
+  int matched() const { return shm_ ? shm_->writers() : matched_.load(); }
   std::uint64_t received() const { return received_.load(); }
   std::uint64_t requestedDeadlineMisses() const { return requested_deadline_misses_.load(); }
-  int aliveWriters() const { return alive_writers_.load(); }
+  int aliveWriters() const { return shm_ ? shm_->writers() : alive_writers_.load(); }
+  bool viaChainChannel() const { return shm_ != nullptr; }
+  // A Polled reader on the chain channel: delivers the newest sample if it is new, on the caller's thread (the
+  // callback runs inside: do not hold a lock it takes). False without the channel.
+  bool pollChannel() { return shm_ && shm_->poll(); }
+  // A Polled reader on the chain channel: sleeps until a new sample came (delivered as pollChannel) or the timeout.
+  bool awaitChannel(std::chrono::nanoseconds timeout) { return shm_ && shm_->awaitNew(timeout); }
 
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     eprosima::fastdds::dds::SampleInfo info;
@@ -103,8 +146,21 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   }
 
  private:
+  void onBytes(const unsigned char* bytes, std::size_t size) {
+    if (size > payload_.max_size) return;
+    std::memcpy(payload_.data, bytes, size);
+    payload_.length = static_cast<std::uint32_t>(size);
+    payload_.pos = 0;
+    if (!type_.deserialize(&payload_, &sample_)) return;
+    ++received_;
+    if (on_sample_) on_sample_(sample_);
+  }
+
   Callback on_sample_;
   Msg sample_;  // persistent: never construct a message per cycle
+  PubSubType type_;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload_;
+  std::unique_ptr<ChainSlotReader> shm_;  // last: its thread stops first
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   std::atomic<int> matched_{0};

@@ -16,7 +16,7 @@ CommandLink::CommandLink(ServiceContext& ctx, HopTrace& hops, double peak_torque
       hops_(hops),
       driver_(peak_torque_Nm, watchdog_timeout_ns),
       reader_(ctx.participant(), "JointCommand", ctx.chainReaderProfile(),
-              [this](const msg::JointCommand& m) { onCommand(m); }) {}
+              [this](const msg::JointCommand& m) { onCommand(m); }, ChainSlotReader::Delivery::Polled) {}
 
 void CommandLink::onCommand(const msg::JointCommand& m) {
   hops_.mark(2, m.tick());
@@ -54,6 +54,13 @@ bool CommandLink::awaitAnswer(std::uint64_t tick, std::chrono::duration<double> 
   const auto answered = [&] { return driver_.answers(tick) && also(); };
   while (!answered() && !shutdownRequested()) {
     if (std::chrono::steady_clock::now() > deadline) break;
+    if (reader_.viaChainChannel() && !driver_.answers(tick)) {  // this thread takes the command: no hand-off
+      lock.unlock();
+      const bool arrived = reader_.awaitChannel(resend);  // onCommand() runs here when it does
+      if (!arrived) republish();
+      lock.lock();
+      continue;
+    }
     if (arrived_.wait_for(lock, resend) == std::cv_status::timeout) {
       lock.unlock();
       republish();

@@ -1,7 +1,8 @@
 #pragma once
 // mft-sim's side of the JointCommand topic: commands arrive on a DDS thread and go through the actuator driver
 // (chain/actuator_driver.hpp: refusal of bad commands, the realtime watchdog and damping) under one mutex; the
-// simulator's loop waits on it (lockstep) or samples the held command once a period (realtime).
+// simulator's loop waits on it (lockstep) or samples the held command once a period (realtime). On the lockstep
+// chain channel the loop thread itself sleeps on the topic's slot and takes the command (no thread hand-off).
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>

@@ -73,13 +73,17 @@ static int toolMain(int argc, char** argv) {
   services::announceReady("mft-sim");
   msg::SensorData sensor_msg;
   msg::GroundTruth truth_msg;
-  auto publish = [&] {  // SensorData first: the estimator answers it; GroundTruth goes out while the chain computes
+  // With DDS SensorData goes first (the estimator answers it; GroundTruth goes out while the chain computes); on
+  // the chain channel GroundTruth first, so that it is in its slot when SensorData wakes the estimator.
+  const bool truth_first = sensor_writer.viaChainChannel();
+  auto publish = [&] {
     services::toMsg(node->truth(), &truth_msg);
     services::toMsg(node->sensors(), &sensor_msg);
     link.published(node->tick());
     hops.mark(0, node->tick());
+    if (truth_first) truth_writer.write(truth_msg);
     sensor_writer.write(sensor_msg);
-    truth_writer.write(truth_msg);
+    if (!truth_first) truth_writer.write(truth_msg);
     hops.mark(1, node->tick());
   };
   const auto start_deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(start_timeout);  // the estimator listens, the controller's writer is there
@@ -89,6 +93,7 @@ static int toolMain(int argc, char** argv) {
                  "JointCommand writers %d)\n", start_timeout.count(), sensor_writer.matched(), link.matchedWriters());
     return 3;
   }
+  if (const auto* channel = ctx.participant().chainChannel()) channel->unlinkName();  // the chain is attached
   // Realtime starts once the chain answered tick 0: a lost discovery message can keep one hop unmatched for a
   // heartbeat period (seconds), and the robot would collapse in start-up damping meanwhile.
   if (!ctx.lockstep() && !link.awaitFirst(start_deadline, resend, publish) && !services::shutdownRequested()) {

@@ -118,9 +118,12 @@ static int toolMain(int argc, char** argv) {
         services::fromMsg(m, &state);
         have_state = true;
         process(true);
-      });
+      }, services::ChainSlotReader::Delivery::Polled);
+  // On the chain channel RobotState(k) is in its slot before the planner answers it with Reference(k): the
+  // Reference takes it first, so the WBC is woken once per tick (with DDS, the state came on its own).
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
+        state_reader.pollChannel();
         hops.mark(1, m.tick());
         std::lock_guard<std::mutex> lock(mutex);
         if (!join.accept(services::validInput(m), "Reference", m.tick())) return;

@@ -15,7 +15,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, CONFIG, SCENARIOS, StackTestCase  # noqa: E402
+from mftstack.testing import BIN, CONFIG, SCENARIOS, StackRunner, StackTestCase  # noqa: E402
 
 DOMAIN_BASE = 140 + (os.getpid() % 20) * 3  # a block of its own, apart from the integration tests' 100-219
 
@@ -63,6 +63,39 @@ class MisuseStackTest(StackTestCase):
         after = json.loads(self.sup("status", "--domain", domain, "--json", env=other_env).stdout)
         self.assertEqual(before["services"], after["services"])  # the running stack was not disturbed
         self.assertTrue(all(s["alive"] for s in after["services"].values()), after)
+
+    def test_the_chain_channel_only_in_a_plain_lockstep_stack_and_nothing_left_in_dev_shm(self):
+        base = [str(BIN / "mft-estimator"), "--domain", str(DOMAIN_BASE + 2), "--scenario", str(SCENARIOS / "stand.yaml")]
+        for extra, message in ((["--mode", "realtime", "--chain-shm", "/mft-chain-x"], "only in lockstep mode"),
+                               (["--chain-shm", "/mft-chain-x", "--secure", str(self.tmp)], "not with --secure"),
+                               (["--chain-shm", "no-leading-slash"], "expected a name like /mft-chain-NAME")):
+            r = subprocess.run(base + extra, capture_output=True, text=True, timeout=60)
+            self.assertEqual(r.returncode, 2, (extra, r.stdout, r.stderr))
+            self.assertIn(message, r.stderr)
+        self.assertFalse(Path("/dev/shm/mft-chain-x").exists())
+        before = {p.name for p in Path("/dev/shm").glob("mft-chain-*")}
+        code, summary, err = self.stacks.run_json("stand.yaml", DOMAIN_BASE + 2, timeout=240)
+        self.assertEqual(code, 0, err[-2000:])
+        self.assertEqual(summary["chain_transport"], "shm")
+        self.assertGreater(summary["ticks"], 0)
+        self.assertEqual({p.name for p in Path("/dev/shm").glob("mft-chain-*")} - before, set(),
+                         "the stack left its chain segment behind")
+        # A stack whose simulator never attached (it exits at once after passing its configuration check): the
+        # other three opened the segment; the supervisor removes it.
+        bin_dir = self.tmp / "bin-sim-fails"
+        bin_dir.mkdir()
+        for exe in BIN.iterdir():
+            (bin_dir / exe.name).symlink_to(exe)
+        (bin_dir / "mft-sim").unlink()
+        (bin_dir / "mft-sim").write_text(f'#!/bin/sh\ncase "$*" in *--check*) exec {BIN / "mft-sim"} "$@";; esac\n'
+                                         'echo "mft-sim: failing on purpose" >&2; exit 3\n')
+        (bin_dir / "mft-sim").chmod(0o755)
+        failing = StackRunner(prefix="mft-misuse-sim-fails-", bin_dir=bin_dir)
+        self.addCleanup(failing.close)
+        code, summary, err = failing.run_json("stand.yaml", DOMAIN_BASE + 2, timeout=240)
+        self.assertNotEqual(code, 0)
+        self.assertIn("mft-sim", summary["error"])
+        self.assertEqual({p.name for p in Path("/dev/shm").glob("mft-chain-*")} - before, set())
 
     def test_mft_participants_lists_what_is_on_a_domain(self):
         domain = DOMAIN_BASE + 1

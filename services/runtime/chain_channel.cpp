@@ -1,0 +1,153 @@
+#include "services/runtime/chain_channel.hpp"
+
+#include <fcntl.h>
+#include <linux/futex.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstring>
+
+namespace mft::services {
+
+namespace {
+
+constexpr std::size_t kSegmentBytes = sizeof(ChainChannel::Slot) * ChainChannel::kSlots;
+static_assert(std::atomic<std::uint32_t>::is_always_lock_free && sizeof(std::atomic<std::uint32_t>) == 4,
+              "the futex word must be a plain 32-bit integer");
+
+// Shared (not FUTEX_PRIVATE): the waiters and the waker are different processes.
+long futexWait(std::atomic<std::uint32_t>* word, std::uint32_t expected, const timespec* timeout) {
+  return syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAIT, expected, timeout, nullptr, 0);
+}
+void futexWakeAll(std::atomic<std::uint32_t>* word) {
+  syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(word), FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
+}
+
+std::string errnoText(const std::string& what, const std::string& name) {
+  return what + " " + name + ": " + std::strerror(errno);
+}
+
+}  // namespace
+
+int chainSlotIndex(const std::string& topic_name) {
+  static const char* const kTopics[ChainChannel::kSlots] = {"SensorData", "GroundTruth", "RobotState", "Reference",
+                                                             "JointCommand"};
+  for (int i = 0; i < ChainChannel::kSlots; ++i)
+    if (topic_name == kTopics[i]) return i;
+  return -1;
+}
+
+ChainChannel::ChainChannel(const std::string& name) : name_(name) {
+  if (name.size() < 2 || name[0] != '/' || name.find('/', 1) != std::string::npos || name.size() > 200)
+    throw ChainChannelError("--chain-shm " + name + ": expected a name like /mft-chain-NAME (one leading slash)");
+  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT, 0600);
+  if (fd < 0) throw ChainChannelError(errnoText("cannot open the shared-memory segment", name));
+  // Every process sizes it: growing a fresh (empty) segment zeroes it; the same size again changes nothing.
+  struct stat st {};
+  if (fstat(fd, &st) != 0 || (static_cast<std::size_t>(st.st_size) != kSegmentBytes && ftruncate(fd, kSegmentBytes) != 0)) {
+    const std::string error = errnoText("cannot size the shared-memory segment", name);
+    close(fd);
+    throw ChainChannelError(error);
+  }
+  void* memory = mmap(nullptr, kSegmentBytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  close(fd);
+  if (memory == MAP_FAILED) throw ChainChannelError(errnoText("cannot map the shared-memory segment", name));
+  slots_ = static_cast<Slot*>(memory);
+}
+
+ChainChannel::~ChainChannel() {
+  if (slots_) munmap(slots_, kSegmentBytes);
+}
+
+void ChainChannel::unlinkName() const { shm_unlink(name_.c_str()); }
+
+ChainSlotWriter::ChainSlotWriter(ChainChannel& channel, int slot_index) : slot_(channel.slot(slot_index)) {
+  slot_.writers.fetch_add(1);
+}
+
+ChainSlotWriter::~ChainSlotWriter() { slot_.writers.fetch_sub(1); }
+
+void ChainSlotWriter::write(const unsigned char* bytes, std::size_t size) {
+  if (size > ChainChannel::kSlotBytes) throw ChainChannelError("a chain sample is larger than its slot");
+  const std::uint32_t seq = slot_.seq.load(std::memory_order_relaxed);
+  slot_.seq.store(seq + 1, std::memory_order_relaxed);  // odd: a reader copying now retries
+  std::atomic_thread_fence(std::memory_order_release);
+  std::memcpy(slot_.data, bytes, size);
+  slot_.size.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
+  slot_.seq.store(seq + 2, std::memory_order_seq_cst);
+  // seq_cst store then load, against the reader's seq_cst increment then load: one of the two sees the other.
+  if (slot_.sleepers.load(std::memory_order_seq_cst) > 0) futexWakeAll(&slot_.seq);
+}
+
+ChainSlotReader::ChainSlotReader(ChainChannel& channel, int slot_index, Deliver deliver, Delivery delivery)
+    : slot_(channel.slot(slot_index)), deliver_(std::move(deliver)) {
+  last_seq_ = slot_.seq.load() & ~1u;  // what is there now is an earlier stack's tick: not delivered
+  slot_.readers.fetch_add(1);
+  if (delivery == Delivery::Woken) thread_ = std::thread([this] { run(); });
+}
+
+ChainSlotReader::~ChainSlotReader() {
+  if (thread_.joinable()) {
+    stop_ = true;
+    futexWakeAll(&slot_.seq);  // a spurious wake-up for the slot's other readers: they look and sleep again
+    thread_.join();
+  }
+  slot_.readers.fetch_sub(1);
+}
+
+ChainSlotReader::Take ChainSlotReader::take(std::uint32_t seq) {
+  if (seq == last_seq_ || (seq & 1u) != 0) return Take::Nothing;
+  const std::uint32_t size = slot_.size.load(std::memory_order_relaxed);
+  std::memcpy(buffer_, slot_.data, size <= sizeof(buffer_) ? size : 0);
+  std::atomic_thread_fence(std::memory_order_acquire);
+  if (slot_.seq.load(std::memory_order_relaxed) != seq) {  // overwritten while copying: take the newer one
+    torn_.fetch_add(1, std::memory_order_relaxed);
+    return Take::Torn;
+  }
+  last_seq_ = seq;
+  deliver_(buffer_, size);
+  return Take::Delivered;
+}
+
+bool ChainSlotReader::poll() {
+  for (;;) {
+    const Take t = take(slot_.seq.load(std::memory_order_acquire));
+    if (t != Take::Torn) return t == Take::Delivered;
+  }
+}
+
+void ChainSlotReader::sleepWhile(std::uint32_t seq, const struct timespec* timeout) {
+  slot_.sleepers.fetch_add(1, std::memory_order_seq_cst);
+  if (slot_.seq.load(std::memory_order_seq_cst) == seq && !stop_.load())
+    futexWait(&slot_.seq, seq, timeout);  // returns at once if seq moved on meanwhile
+  slot_.sleepers.fetch_sub(1, std::memory_order_seq_cst);
+}
+
+bool ChainSlotReader::awaitNew(std::chrono::nanoseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    const std::uint32_t seq = slot_.seq.load(std::memory_order_acquire);
+    const Take t = take(seq);
+    if (t == Take::Delivered) return true;
+    if (t == Take::Torn) continue;
+    const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    const timespec ts{static_cast<time_t>(left.count() / 1000000000), static_cast<long>(left.count() % 1000000000)};
+    sleepWhile(seq, &ts);
+  }
+}
+
+void ChainSlotReader::run() {
+  const timespec poll_stop{0, 100 * 1000 * 1000};  // the longest a stopping reader sleeps on
+  while (!stop_.load(std::memory_order_relaxed)) {
+    const std::uint32_t seq = slot_.seq.load(std::memory_order_acquire);
+    if (take(seq) == Take::Nothing) sleepWhile(seq, &poll_stop);
+  }
+}
+
+}  // namespace mft::services

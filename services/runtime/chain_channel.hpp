@@ -1,0 +1,117 @@
+#pragma once
+// The lockstep chain's shared-memory channel (docs/loop-benchmark.md#the-shared-memory-chain): the five topics
+// the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) go between the four
+// chain services of one stack through a POSIX shared-memory segment the supervisor names, instead of through
+// the DDS stack. Each topic has one slot: a sequence counter (a seqlock: odd while the writer copies) that is
+// also the futex the readers sleep on, and the sample's serialized bytes. A write is a copy and, when a reader
+// sleeps, one FUTEX_WAKE: a hop costs about one thread wake-up instead of a UDP send, a receive and a listener
+// dispatch. The writers still publish every sample on DDS too, for the recorder and every other reader.
+//
+// Latest-value semantics (a reader that is late sees the newest sample), which the lockstep chain satisfies: a
+// stage writes tick k+1 only after the whole chain answered tick k. One writer per slot. No DDS here.
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+namespace mft::services {
+
+class ChainChannelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The topics the channel carries, by the logical names TopicWriter/TopicReader are given; -1 for any other.
+int chainSlotIndex(const std::string& topic_name);
+
+class ChainChannel {
+ public:
+  static constexpr std::size_t kSlotBytes = 2048;  // larger than every chain topic's serialized size (checked)
+  static constexpr int kSlots = 5;
+
+  struct Slot {
+    alignas(64) std::atomic<std::uint32_t> seq;  // even: stable, odd: being written; the futex word
+    std::atomic<std::uint32_t> sleepers;          // readers inside FUTEX_WAIT (the writer wakes only then)
+    std::atomic<std::uint32_t> readers;           // attached readers and writers: the channel's "matched"
+    std::atomic<std::uint32_t> writers;
+    std::atomic<std::uint32_t> size;
+    alignas(64) unsigned char data[kSlotBytes];
+  };
+
+  // Opens (creating it if needed) the segment `name` ("/mft-chain-…", as shm_open takes it). Every process of
+  // the stack opens the same name; the first one sizes it and the memory starts zeroed. Throws
+  // ChainChannelError with the reason.
+  explicit ChainChannel(const std::string& name);
+  ~ChainChannel();
+  ChainChannel(const ChainChannel&) = delete;
+  ChainChannel& operator=(const ChainChannel&) = delete;
+
+  const std::string& name() const { return name_; }
+  // Removes the name once every process of the stack has the segment mapped (the mappings stay): nothing is
+  // left in /dev/shm whatever happens to the stack afterwards.
+  void unlinkName() const;
+  Slot& slot(int index) { return slots_[index]; }
+
+ private:
+  std::string name_;
+  Slot* slots_ = nullptr;
+};
+
+// Writes one topic's samples into its slot (the bytes given; the caller serializes).
+class ChainSlotWriter {
+ public:
+  ChainSlotWriter(ChainChannel& channel, int slot_index);
+  ~ChainSlotWriter();
+  ChainSlotWriter(const ChainSlotWriter&) = delete;
+  ChainSlotWriter& operator=(const ChainSlotWriter&) = delete;
+
+  void write(const unsigned char* bytes, std::size_t size);
+  int readers() const { return static_cast<int>(slot_.readers.load()); }
+
+ private:
+  ChainChannel::Slot& slot_;
+};
+
+// Takes one slot's new samples and hands their bytes to `deliver`. Woken: a thread of its own sleeps on the slot
+// and delivers each sample as it comes. Polled: no thread, no wake-up of this process by the writer; the owner
+// calls poll() when it knows a sample is there (a topic written before the one it was woken by) or awaitNew()
+// to sleep on the slot in its own thread. Samples written before it attached are not delivered (as a volatile
+// DDS reader).
+class ChainSlotReader {
+ public:
+  using Deliver = std::function<void(const unsigned char* bytes, std::size_t size)>;
+  enum class Delivery { Woken, Polled };
+  ChainSlotReader(ChainChannel& channel, int slot_index, Deliver deliver, Delivery delivery = Delivery::Woken);
+  ~ChainSlotReader();  // stops and joins the thread
+  ChainSlotReader(const ChainSlotReader&) = delete;
+  ChainSlotReader& operator=(const ChainSlotReader&) = delete;
+
+  // Polled: delivers the newest sample if it is new (on the caller's thread); whether it did.
+  bool poll();
+  // Polled: sleeps until a new sample is in the slot or `timeout` passed, then poll().
+  bool awaitNew(std::chrono::nanoseconds timeout);
+
+  int writers() const { return static_cast<int>(slot_.writers.load()); }
+  std::uint64_t torn() const { return torn_.load(); }  // copies retried because the writer overwrote them
+
+ private:
+  enum class Take { Delivered, Nothing, Torn };
+  Take take(std::uint32_t seq);
+  void sleepWhile(std::uint32_t seq, const struct timespec* timeout);
+  void run();
+
+  ChainChannel::Slot& slot_;
+  Deliver deliver_;
+  std::uint32_t last_seq_;
+  std::atomic<bool> stop_{false};
+  std::atomic<std::uint64_t> torn_{0};
+  unsigned char buffer_[ChainChannel::kSlotBytes];
+  std::thread thread_;
+};
+
+}  // namespace mft::services

@@ -214,7 +214,7 @@ class Stack:
             if self.stack:
                 host = self.stack.placement[name]
                 argv = self.stack.launcher(host) + argv + ["--profiles", str(profiles[host])]
-            if self.chain_shm and name in CORE_SERVICES + ["mft-sim"]:
+            if self.chain_shm:  # the four chain services, and the recorder for the 1 kHz topics
                 argv += ["--chain-shm", self.chain_shm]
             if name == "mft-record":
                 argv += ["--output", str(Path(args.record).resolve())] + (["--overwrite"] if args.overwrite else [])

@@ -98,17 +98,24 @@ static int toolMain(int argc, char** argv) {
   }
   const long poll_us = cli.getInt("poll-us", 0, 100000);
   std::unique_ptr<services::RecordParticipant> participant;
+  std::unique_ptr<services::ChainChannel> channel;  // a lockstep stack's chain channel: the 1 kHz topics from there
   std::unique_ptr<services::TopicTable> topics;
   try {
+    if (!cli.get("chain-shm").empty()) {
+      if (!lockstep || !cli.get("secure").empty()) cli.fail("--chain-shm: only in lockstep mode, without --secure");
+      channel = std::make_unique<services::ChainChannel>(cli.get("chain-shm"));
+    }
     participant = std::make_unique<services::RecordParticipant>(
         opt.metadata.domain, services::ServiceContext::profilesFile(cli),
         services::ReceiveTuning{static_cast<std::uint32_t>(cli.getDouble("socket-buffer-mb", 0.1, 256) * 1024 * 1024),
                                 std::chrono::microseconds(poll_us)},
         services::SecurityOptions{cli.get("secure"), "record"});
     topics = std::make_unique<services::TopicTable>(*participant, recorder, lockstep ? "lockstep_reader" : "control_reader",
-                                                    reader_qos == "best_effort");
+                                                    reader_qos == "best_effort", channel.get());
     if (lockstep) participant->enableProgress();
   } catch (const services::DdsError& e) {
+    cli.fail(e.what());
+  } catch (const services::ChainChannelError& e) {
     cli.fail(e.what());
   }
   services::ProgressReporter progress;
@@ -130,6 +137,7 @@ static int toolMain(int argc, char** argv) {
   while (steady() < give_up && steady() - recorder.lastPushWallNs() < static_cast<std::int64_t>(linger_s * 1e9))
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   const std::string cpu_json = services::threadCpuJson();  // while the DDS threads still exist
+  const std::uint64_t channel_lost = topics->channelLost();
   topics.reset();  // readers gone: no more pushes
   recorder.stop();
   const auto s = recorder.stats();
@@ -140,6 +148,7 @@ static int toolMain(int argc, char** argv) {
   config::JsonWriter w;
   w.beginObject().field("service", "mft-record").field("file", opt.output).field("mode", mode).key("cpu_s").raw(cpu_json);
   services::writePollFields(w, priority.starvationFallbacks());
+  w.field("chain_channel", channel != nullptr).field("chain_channel_lost", channel_lost);
   recorder.writeSummary(w);
   services::writeSummaryFile(cli.get("summary"), w.endObject().str(), "mft-record");
   return s.error.empty() ? 0 : 1;

@@ -1,15 +1,23 @@
 #pragma once
 // What mft-record subscribes to, one reader per topic: each DDS receive thread only copies the sample into the
 // recorder's queue and keeps the topic's count and newest tick. From those, the lockstep progress it publishes.
+// In a lockstep stack on the chain channel (--chain-shm), the 1 kHz topics come from the channel's rings instead
+// (services/runtime/chain_channel.hpp), drained by one thread every millisecond: the writers then send nothing
+// over DDS for the recorder.
 // Not recorded: CommandVerdict (the stack's answer to mft-cmd). Its reason is text, which rawlog schema 1's
 // numeric channels cannot hold, and a new topic would change the schema that older recordings and tools share;
 // the commands themselves are recorded, and each verdict (with the tick a command was applied at) is in the
 // planner's and simulator's logs and summaries (docs/operator-commands.md).
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <thread>
 #include <type_traits>
+
+#include <fastdds/rtps/common/SerializedPayload.h>
 
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -19,6 +27,7 @@
 
 #include "services/record/record_participant.hpp"
 #include "services/record/recorder.hpp"
+#include "services/runtime/chain_channel.hpp"
 #include "services/runtime/topic_names.hpp"
 
 namespace mft::services {
@@ -33,9 +42,14 @@ template <class Msg, class PubSubType>
 class Subscription : public eprosima::fastdds::dds::DataReaderListener {
  public:
   Subscription(RecordParticipant& p, const std::string& topic_name, const std::string& profile, rawlog::Recorder& rec,
-               bool best_effort = false)
+               bool best_effort = false, ChainChannel* channel = nullptr)
       : subscriber_(p.subscriber()), recorder_(rec) {
     namespace dds = eprosima::fastdds::dds;
+    if (channel && chainSlotIndex(topic_name) >= 0) {
+      archive_ = std::make_unique<ChainSlotArchive>(*channel, chainSlotIndex(topic_name));
+      payload_.reserve(type_.m_typeSize);
+      return;
+    }
     dds::TypeSupport type(new PubSubType());
     type.register_type(p.get());
     topic_ = p.get()->create_topic(ddsTopicName(topic_name), type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
@@ -47,21 +61,37 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
     reader_ = subscriber_->create_datareader(topic_, qos, this);
     if (!reader_) throw DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
   }
-  ~Subscription() override { subscriber_->delete_datareader(reader_); }
+  ~Subscription() override {
+    if (reader_) subscriber_->delete_datareader(reader_);
+  }
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
-      if (info.valid_data) {
-        recorder_.push(rawlog::Message(sample_));
-        received_.fetch_add(1, std::memory_order_relaxed);
-        if constexpr (HasTick<Msg>::value)
-          if (sample_.tick() > last_tick_.load(std::memory_order_relaxed)) last_tick_.store(sample_.tick(), std::memory_order_relaxed);
-      }
+      if (info.valid_data) take();
+  }
+  // On the chain channel: every sample written since the last call, from the caller's (the drainer's) thread.
+  void drainChannel() {
+    if (!archive_) return;
+    archive_->drain([this](const unsigned char* bytes, std::size_t size) {
+      if (size > payload_.max_size) return;
+      std::memcpy(payload_.data, bytes, size);
+      payload_.length = static_cast<std::uint32_t>(size);
+      payload_.pos = 0;
+      if (type_.deserialize(&payload_, &sample_)) take();
+    });
   }
   std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
   std::uint64_t lastTick() const { return last_tick_.load(std::memory_order_relaxed); }
+  std::uint64_t channelLost() const { return archive_ ? archive_->lost() : 0; }
 
  private:
+  void take() {
+    recorder_.push(rawlog::Message(sample_));
+    received_.fetch_add(1, std::memory_order_relaxed);
+    if constexpr (HasTick<Msg>::value)
+      if (sample_.tick() > last_tick_.load(std::memory_order_relaxed)) last_tick_.store(sample_.tick(), std::memory_order_relaxed);
+  }
+
   eprosima::fastdds::dds::Subscriber* subscriber_;
   rawlog::Recorder& recorder_;
   eprosima::fastdds::dds::Topic* topic_ = nullptr;
@@ -69,31 +99,49 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
   Msg sample_;
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> last_tick_{0};
+  std::unique_ptr<ChainSlotArchive> archive_;
+  PubSubType type_;
+  eprosima::fastrtps::rtps::SerializedPayload_t payload_;
 };
 
 // Every recorded topic. The 1 kHz chain's readers use `chain_profile` (best effort with `best_effort`: the chain's
 // writers offer best effort in both modes, lockstep recovers a lost sample by re-sending the tick, and a reader
 // asking for more would not match; losses show as tick gaps, re-sent ticks as repeats).
 struct TopicTable {
-  TopicTable(RecordParticipant& p, rawlog::Recorder& r, const std::string& chain_profile, bool best_effort)
-      : truth(p, "GroundTruth", chain_profile, r, best_effort),
-        sensors(p, "SensorData", chain_profile, r, best_effort),
-        state(p, "RobotState", chain_profile, r, best_effort),
-        reference(p, "Reference", chain_profile, r, best_effort),
-        command(p, "JointCommand", chain_profile, r, best_effort),
-        diagnostics(p, "WbcDiagnostics", chain_profile, r, best_effort),
+  TopicTable(RecordParticipant& p, rawlog::Recorder& r, const std::string& chain_profile, bool best_effort,
+             ChainChannel* channel = nullptr)
+      : truth(p, "GroundTruth", chain_profile, r, best_effort, channel),
+        sensors(p, "SensorData", chain_profile, r, best_effort, channel),
+        state(p, "RobotState", chain_profile, r, best_effort, channel),
+        reference(p, "Reference", chain_profile, r, best_effort, channel),
+        command(p, "JointCommand", chain_profile, r, best_effort, channel),
+        diagnostics(p, "WbcDiagnostics", chain_profile, r, best_effort, channel),
         operator_command(p, "OperatorCommand", "event_reader", r),
         disturbance(p, "Disturbance", "event_reader", r),
-        config_change(p, "ConfigChange", "event_reader", r) {}
+        config_change(p, "ConfigChange", "event_reader", r) {
+    if (channel) drainer_ = std::thread([this] { drainLoop(); });
+  }
+  ~TopicTable() {
+    stop_ = true;
+    if (drainer_.joinable()) drainer_.join();
+  }
+  // Samples the ring overwrote before the drainer took them (zero while the simulator's recorder window holds).
+  std::uint64_t channelLost() const {
+    return truth.channelLost() + sensors.channelLost() + state.channelLost() + reference.channelLost() +
+           command.channelLost() + diagnostics.channelLost();
+  }
 
   // Every 1 kHz topic has delivered at least one sample.
   bool flowing() const {
     return truth.received() && sensors.received() && state.received() && reference.received() && command.received() &&
            diagnostics.received();
   }
-  // The newest tick seen on any 1 kHz topic (the socket is a FIFO: everything sent before it has been taken in, or
-  // was lost, and waiting for it would deadlock the run), and the newest tick seen on all of them.
+  // The tick the simulator's window counts from. Over DDS: the newest tick seen on any 1 kHz topic (the socket is a
+  // FIFO: everything sent before it has been taken in, or was lost, and waiting for it would deadlock the run).
+  // On the chain channel: the newest tick seen on all of them, as each topic has its own ring, drained one after
+  // the other by a background thread that may stop between two (the window must cover the slowest ring).
   std::uint64_t newestTick() const {
+    if (drainer_.joinable()) return allTopicsTick();
     return std::max({truth.lastTick(), sensors.lastTick(), state.lastTick(), reference.lastTick(), command.lastTick(),
                      diagnostics.lastTick()});
   }
@@ -116,6 +164,26 @@ struct TopicTable {
   Subscription<msg::Disturbance, msg::DisturbancePubSubType> disturbance;
   // Live tuning: the requests and the changes the WBC and the planner applied, with their ticks (label config_change).
   Subscription<msg::ConfigChange, msg::ConfigChangePubSubType> config_change;
+
+ private:
+  void drainChannel() {
+    truth.drainChannel();
+    sensors.drainChannel();
+    state.drainChannel();
+    reference.drainChannel();
+    command.drainChannel();
+    diagnostics.drainChannel();
+  }
+  // Every millisecond, as the polling UDP path drains its sockets: a tick's six samples come in one pass.
+  void drainLoop() {
+    while (!stop_.load()) {
+      drainChannel();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    drainChannel();  // what came during the last sleep
+  }
+  std::atomic<bool> stop_{false};
+  std::thread drainer_;
 };
 
 // Lockstep: publishes how far the recorder has read its socket (the simulator waits when this falls more than its

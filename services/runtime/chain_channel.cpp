@@ -36,7 +36,7 @@ std::string errnoText(const std::string& what, const std::string& name) {
 
 int chainSlotIndex(const std::string& topic_name) {
   static const char* const kTopics[ChainChannel::kSlots] = {"SensorData", "GroundTruth", "RobotState", "Reference",
-                                                             "JointCommand"};
+                                                             "JointCommand", "WbcDiagnostics"};
   for (int i = 0; i < ChainChannel::kSlots; ++i)
     if (topic_name == kTopics[i]) return i;
   return -1;
@@ -74,19 +74,32 @@ ChainSlotWriter::~ChainSlotWriter() { slot_.writers.fetch_sub(1); }
 
 void ChainSlotWriter::write(const unsigned char* bytes, std::size_t size) {
   if (size > ChainChannel::kSlotBytes) throw ChainChannelError("a chain sample is larger than its slot");
-  const std::uint32_t seq = slot_.seq.load(std::memory_order_relaxed);
-  slot_.seq.store(seq + 1, std::memory_order_relaxed);  // odd: a reader copying now retries
+  const std::uint32_t n = slot_.head.load(std::memory_order_relaxed);
+  ChainChannel::Entry& entry = slot_.ring[n % ChainChannel::kRing];
+  entry.seq.store(2 * n + 1, std::memory_order_relaxed);  // odd: a reader copying this entry now retries
   std::atomic_thread_fence(std::memory_order_release);
-  std::memcpy(slot_.data, bytes, size);
-  slot_.size.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
-  slot_.seq.store(seq + 2, std::memory_order_seq_cst);
+  std::memcpy(entry.data, bytes, size);
+  entry.size.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
+  entry.seq.store(2 * n + 2, std::memory_order_release);
+  slot_.head.store(n + 1, std::memory_order_seq_cst);
   // seq_cst store then load, against the reader's seq_cst increment then load: one of the two sees the other.
-  if (slot_.sleepers.load(std::memory_order_seq_cst) > 0) futexWakeAll(&slot_.seq);
+  if (slot_.sleepers.load(std::memory_order_seq_cst) > 0) futexWakeAll(&slot_.head);
+}
+
+long copyChainSample(const ChainChannel::Slot& slot, std::uint32_t n, unsigned char* buffer) {
+  const ChainChannel::Entry& entry = slot.ring[n % ChainChannel::kRing];
+  if (entry.seq.load(std::memory_order_acquire) != 2 * n + 2) return -1;
+  const std::uint32_t size = entry.size.load(std::memory_order_relaxed);
+  if (size > ChainChannel::kSlotBytes) return -1;
+  std::memcpy(buffer, entry.data, size);
+  std::atomic_thread_fence(std::memory_order_acquire);
+  if (entry.seq.load(std::memory_order_relaxed) != 2 * n + 2) return -1;  // overwritten while copying
+  return static_cast<long>(size);
 }
 
 ChainSlotReader::ChainSlotReader(ChainChannel& channel, int slot_index, Deliver deliver, Delivery delivery)
     : slot_(channel.slot(slot_index)), deliver_(std::move(deliver)) {
-  last_seq_ = slot_.seq.load() & ~1u;  // what is there now is an earlier stack's tick: not delivered
+  last_head_ = slot_.head.load();  // what is there now is an earlier stack's tick: not delivered
   slot_.readers.fetch_add(1);
   if (delivery == Delivery::Woken) thread_ = std::thread([this] { run(); });
 }
@@ -94,60 +107,84 @@ ChainSlotReader::ChainSlotReader(ChainChannel& channel, int slot_index, Deliver 
 ChainSlotReader::~ChainSlotReader() {
   if (thread_.joinable()) {
     stop_ = true;
-    futexWakeAll(&slot_.seq);  // a spurious wake-up for the slot's other readers: they look and sleep again
+    futexWakeAll(&slot_.head);  // a spurious wake-up for the slot's other readers: they look and sleep again
     thread_.join();
   }
   slot_.readers.fetch_sub(1);
 }
 
-ChainSlotReader::Take ChainSlotReader::take(std::uint32_t seq) {
-  if (seq == last_seq_ || (seq & 1u) != 0) return Take::Nothing;
-  const std::uint32_t size = slot_.size.load(std::memory_order_relaxed);
-  std::memcpy(buffer_, slot_.data, size <= sizeof(buffer_) ? size : 0);
-  std::atomic_thread_fence(std::memory_order_acquire);
-  if (slot_.seq.load(std::memory_order_relaxed) != seq) {  // overwritten while copying: take the newer one
+ChainSlotReader::Take ChainSlotReader::take(std::uint32_t head) {
+  if (head == last_head_) return Take::Nothing;
+  const long size = copyChainSample(slot_, head - 1, buffer_);
+  if (size < 0) {  // lapped while copying (a writer far ahead): take the newer one
     torn_.fetch_add(1, std::memory_order_relaxed);
     return Take::Torn;
   }
-  last_seq_ = seq;
-  deliver_(buffer_, size);
+  last_head_ = head;
+  deliver_(buffer_, static_cast<std::size_t>(size));
   return Take::Delivered;
 }
 
 bool ChainSlotReader::poll() {
   for (;;) {
-    const Take t = take(slot_.seq.load(std::memory_order_acquire));
+    const Take t = take(slot_.head.load(std::memory_order_acquire));
     if (t != Take::Torn) return t == Take::Delivered;
   }
 }
 
-void ChainSlotReader::sleepWhile(std::uint32_t seq, const struct timespec* timeout) {
+void ChainSlotReader::sleepWhile(std::uint32_t head, const struct timespec* timeout) {
   slot_.sleepers.fetch_add(1, std::memory_order_seq_cst);
-  if (slot_.seq.load(std::memory_order_seq_cst) == seq && !stop_.load())
-    futexWait(&slot_.seq, seq, timeout);  // returns at once if seq moved on meanwhile
+  if (slot_.head.load(std::memory_order_seq_cst) == head && !stop_.load())
+    futexWait(&slot_.head, head, timeout);  // returns at once if head moved on meanwhile
   slot_.sleepers.fetch_sub(1, std::memory_order_seq_cst);
 }
 
 bool ChainSlotReader::awaitNew(std::chrono::nanoseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    const std::uint32_t seq = slot_.seq.load(std::memory_order_acquire);
-    const Take t = take(seq);
+    const std::uint32_t head = slot_.head.load(std::memory_order_acquire);
+    const Take t = take(head);
     if (t == Take::Delivered) return true;
     if (t == Take::Torn) continue;
     const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return false;
     const timespec ts{static_cast<time_t>(left.count() / 1000000000), static_cast<long>(left.count() % 1000000000)};
-    sleepWhile(seq, &ts);
+    sleepWhile(head, &ts);
   }
 }
 
 void ChainSlotReader::run() {
   const timespec poll_stop{0, 100 * 1000 * 1000};  // the longest a stopping reader sleeps on
   while (!stop_.load(std::memory_order_relaxed)) {
-    const std::uint32_t seq = slot_.seq.load(std::memory_order_acquire);
-    if (take(seq) == Take::Nothing) sleepWhile(seq, &poll_stop);
+    const std::uint32_t head = slot_.head.load(std::memory_order_acquire);
+    if (take(head) == Take::Nothing) sleepWhile(head, &poll_stop);
   }
+}
+
+ChainSlotArchive::ChainSlotArchive(ChainChannel& channel, int slot_index)
+    : slot_(channel.slot(slot_index)), cursor_(slot_.head.load()) {
+  slot_.readers.fetch_add(1);
+}
+
+ChainSlotArchive::~ChainSlotArchive() { slot_.readers.fetch_sub(1); }
+
+std::uint64_t ChainSlotArchive::drain(const Deliver& deliver) {
+  const std::uint32_t head = slot_.head.load(std::memory_order_acquire);
+  if (head - cursor_ > ChainChannel::kRing) {  // lapped: the oldest entries are gone
+    lost_ += head - cursor_ - ChainChannel::kRing;
+    cursor_ = head - ChainChannel::kRing;
+  }
+  std::uint64_t delivered = 0;
+  for (; cursor_ != head; ++cursor_) {
+    const long size = copyChainSample(slot_, cursor_, buffer_);
+    if (size < 0) {
+      ++lost_;
+      continue;
+    }
+    deliver(buffer_, static_cast<std::size_t>(size));
+    ++delivered;
+  }
+  return delivered;
 }
 
 }  // namespace mft::services

@@ -1,14 +1,15 @@
 #pragma once
-// The lockstep chain's shared-memory channel (docs/loop-benchmark.md#the-shared-memory-chain): the five topics
-// the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) go between the four
-// chain services of one stack through a POSIX shared-memory segment the supervisor names, instead of through
-// the DDS stack. Each topic has one slot: a sequence counter (a seqlock: odd while the writer copies) that is
-// also the futex the readers sleep on, and the sample's serialized bytes. A write is a copy and, when a reader
-// sleeps, one FUTEX_WAKE: a hop costs about one thread wake-up instead of a UDP send, a receive and a listener
-// dispatch. The writers still publish every sample on DDS too, for the recorder and every other reader.
+// The lockstep chain's shared-memory channel (docs/loop-benchmark.md#the-shared-memory-chain-channel): the topics
+// the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics go
+// between the processes of one stack (the four chain services and the recorder) through a POSIX shared-memory
+// segment the supervisor names, instead of through the DDS stack. Each topic has one slot: a ring of the last
+// kRing samples' serialized bytes, each entry guarded by its own sequence word (a seqlock), and a head counter
+// that is also the futex the chain's readers sleep on. A write is a copy and, when a reader sleeps, one
+// FUTEX_WAKE: a hop costs about one thread wake-up instead of a UDP send, a receive and a listener dispatch.
 //
-// Latest-value semantics (a reader that is late sees the newest sample), which the lockstep chain satisfies: a
-// stage writes tick k+1 only after the whole chain answered tick k. One writer per slot. No DDS here.
+// The chain's readers take the newest sample (a stage writes tick k+1 only after the whole chain answered tick k);
+// the recorder takes every sample in order (ChainSlotArchive), kept within the ring by the simulator's recorder
+// window, and counts what the writer overwrote before it got there. One writer per slot. No DDS here.
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -32,15 +33,20 @@ int chainSlotIndex(const std::string& topic_name);
 class ChainChannel {
  public:
   static constexpr std::size_t kSlotBytes = 2048;  // larger than every chain topic's serialized size (checked)
-  static constexpr int kSlots = 5;
+  static constexpr std::uint32_t kRing = 256;      // more than the simulator's recorder window (200 ticks)
+  static constexpr int kSlots = 6;
 
+  struct Entry {
+    alignas(64) std::atomic<std::uint32_t> seq;  // sample n: 2n+1 while written, 2n+2 once whole
+    std::atomic<std::uint32_t> size;
+    alignas(64) unsigned char data[kSlotBytes];
+  };
   struct Slot {
-    alignas(64) std::atomic<std::uint32_t> seq;  // even: stable, odd: being written; the futex word
+    alignas(64) std::atomic<std::uint32_t> head;  // samples written so far; the futex word
     std::atomic<std::uint32_t> sleepers;          // readers inside FUTEX_WAIT (the writer wakes only then)
     std::atomic<std::uint32_t> readers;           // attached readers and writers: the channel's "matched"
     std::atomic<std::uint32_t> writers;
-    std::atomic<std::uint32_t> size;
-    alignas(64) unsigned char data[kSlotBytes];
+    Entry ring[kRing];
   };
 
   // Opens (creating it if needed) the segment `name` ("/mft-chain-…", as shm_open takes it). Every process of
@@ -61,6 +67,10 @@ class ChainChannel {
   std::string name_;
   Slot* slots_ = nullptr;
 };
+
+// Copies sample `n` of `slot` into `buffer` if it is whole and still there; its size, or -1 (overwritten or
+// being written).
+long copyChainSample(const ChainChannel::Slot& slot, std::uint32_t n, unsigned char* buffer);
 
 // Writes one topic's samples into its slot (the bytes given; the caller serializes).
 class ChainSlotWriter {
@@ -101,17 +111,38 @@ class ChainSlotReader {
 
  private:
   enum class Take { Delivered, Nothing, Torn };
-  Take take(std::uint32_t seq);
-  void sleepWhile(std::uint32_t seq, const struct timespec* timeout);
+  Take take(std::uint32_t head);
+  void sleepWhile(std::uint32_t head, const struct timespec* timeout);
   void run();
 
   ChainChannel::Slot& slot_;
   Deliver deliver_;
-  std::uint32_t last_seq_;
+  std::uint32_t last_head_;
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> torn_{0};
   unsigned char buffer_[ChainChannel::kSlotBytes];
   std::thread thread_;
+};
+
+// The recorder's side of a slot: every sample in the order written, taken by drain() from the owner's thread
+// (no wake-ups: the recorder polls). Samples written before it attached are not taken.
+class ChainSlotArchive {
+ public:
+  using Deliver = ChainSlotReader::Deliver;
+  ChainSlotArchive(ChainChannel& channel, int slot_index);
+  ~ChainSlotArchive();
+  ChainSlotArchive(const ChainSlotArchive&) = delete;
+  ChainSlotArchive& operator=(const ChainSlotArchive&) = delete;
+
+  // Delivers every sample written since the last call, in order; returns how many.
+  std::uint64_t drain(const Deliver& deliver);
+  std::uint64_t lost() const { return lost_; }  // overwritten before drain() got to them
+
+ private:
+  ChainChannel::Slot& slot_;
+  std::uint32_t cursor_;
+  std::uint64_t lost_ = 0;
+  unsigned char buffer_[ChainChannel::kSlotBytes];
 };
 
 }  // namespace mft::services

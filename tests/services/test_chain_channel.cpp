@@ -1,7 +1,7 @@
 // The lockstep chain's shared-memory channel (services/runtime/chain_channel.hpp): every sample arrives once,
 // whole and in order through a ping-pong as the chain runs it, in one process and across two; a late reader
 // does not get an earlier stack's sample; a copy torn by a concurrent write is never delivered; bad names are
-// refused with the reason.
+// refused with the reason; the recorder's archive takes every sample in order and counts what the ring lost.
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -59,13 +59,14 @@ struct Inbox {
 
 }  // namespace
 
-TEST(ChainChannel, NamesTheFiveChainTopicsOnly) {
+TEST(ChainChannel, NamesTheChainTopicsAndTheDiagnosticsOnly) {
   EXPECT_EQ(chainSlotIndex("SensorData"), 0);
   EXPECT_EQ(chainSlotIndex("GroundTruth"), 1);
   EXPECT_EQ(chainSlotIndex("RobotState"), 2);
   EXPECT_EQ(chainSlotIndex("Reference"), 3);
   EXPECT_EQ(chainSlotIndex("JointCommand"), 4);
-  EXPECT_EQ(chainSlotIndex("WbcDiagnostics"), -1);
+  EXPECT_EQ(chainSlotIndex("WbcDiagnostics"), 5);
+  EXPECT_EQ(chainSlotIndex("RecorderProgress"), -1);
   EXPECT_EQ(chainSlotIndex("OperatorCommand"), -1);
 }
 
@@ -201,4 +202,40 @@ TEST(ChainChannel, RefusesASampleLargerThanItsSlot) {
   ChainSlotWriter writer(channel, 0);
   const std::vector<unsigned char> too_large(ChainChannel::kSlotBytes + 1, 0);
   EXPECT_THROW(writer.write(too_large.data(), too_large.size()), ChainChannelError);
+}
+
+// The recorder's archive: every sample in order while it drains at least once per ring; a writer that laps it
+// loses the oldest samples, counted, and the archive goes on with the ones still there.
+TEST(ChainChannel, ArchiveTakesEverySampleInOrderAndCountsWhatTheRingLost) {
+  const Unlink segment{uniqueName("archive")};
+  ChainChannel writer_side(segment.name), recorder_side(segment.name);
+  ChainSlotWriter writer(writer_side, 5);
+  ChainSlotArchive archive(recorder_side, 5);
+  EXPECT_EQ(writer.readers(), 1);
+  std::vector<std::vector<unsigned char>> got;
+  const auto keep = [&](const unsigned char* bytes, std::size_t size) { got.emplace_back(bytes, bytes + size); };
+  std::uint32_t n = 0;
+  for (int round = 0; round < 10; ++round) {  // 10 rounds of a full ring each
+    for (std::uint32_t i = 0; i < ChainChannel::kRing; ++i, ++n) {
+      const auto sample = pattern(n, 40 + n % 100);
+      writer.write(sample.data(), sample.size());
+    }
+    EXPECT_EQ(archive.drain(keep), ChainChannel::kRing);
+  }
+  ASSERT_EQ(got.size(), n);
+  for (std::uint32_t i = 0; i < n; ++i) ASSERT_EQ(got[i], pattern(i, 40 + i % 100)) << "sample " << i;
+  EXPECT_EQ(archive.lost(), 0u);
+  // Lapped: 3 rings' worth written, the last ring is still there.
+  got.clear();
+  const std::uint32_t first = n;
+  for (std::uint32_t i = 0; i < 3 * ChainChannel::kRing; ++i, ++n) {
+    const auto sample = pattern(n, 64);
+    writer.write(sample.data(), sample.size());
+  }
+  EXPECT_EQ(archive.drain(keep), ChainChannel::kRing);
+  EXPECT_EQ(archive.lost(), 2u * ChainChannel::kRing);
+  ASSERT_EQ(got.size(), ChainChannel::kRing);
+  EXPECT_EQ(got.front(), pattern(first + 2 * ChainChannel::kRing, 64));
+  EXPECT_EQ(got.back(), pattern(n - 1, 64));
+  EXPECT_EQ(archive.drain(keep), 0u);  // nothing new
 }

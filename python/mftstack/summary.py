@@ -25,6 +25,22 @@ def report_unwritten(not_written):
               file=sys.stderr, flush=True)
 
 
+def deadline_misses_by_service(stack):
+    """Every service's deadline misses: the simulator's watchdog (those in a CPU stall of the machine apart, with
+    --stall-probe) and each chain reader's while its topic flowed; the readers' misses before the first sample and
+    after the last (the stack starting and stopping) apart, as `outside_stream`."""
+    out = {}
+    for name, svc in stack.services.items():
+        s = svc.summary() or {}
+        if name == "mft-sim":
+            out[name] = {"watchdog": s.get("deadline_misses"), "during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
+                         "reader": s.get("reader_deadline_misses"),
+                         "outside_stream": s.get("reader_deadline_misses_outside_stream")}
+        elif "deadline_misses" in s:
+            out[name] = {"reader": s.get("deadline_misses"), "outside_stream": s.get("deadline_misses_outside_stream")}
+    return out
+
+
 def build_summary(stack, wall_s, error):
     sim = stack.services["mft-sim"].summary() or {}
     wbc = (stack.services["mft-wbc"].summary() if "mft-wbc" in stack.services else None) or {}
@@ -38,6 +54,7 @@ def build_summary(stack, wall_s, error):
         "fell": sim.get("fell"), "sim_time_s": sim.get("sim_time_s"), "wall_time_s": round(wall_s, 3),
         "ticks": sim.get("ticks"), "real_time_factor": None,
         "deadline_misses": sim.get("deadline_misses", 0) + wbc.get("deadline_misses", 0),
+        "deadline_misses_by_service": deadline_misses_by_service(stack),
         "restarts": sum(s.restarts for s in stack.services.values()),
         "wbc_solve_us": wbc.get("solve_time_us"), "wbc_tick_us": wbc.get("tick_time_us"),
         "wbc_safety_events": wbc.get("safety_events"),

@@ -115,7 +115,11 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
 
   int matched() const { return shm_ ? shm_->writers() : matched_.load(); }
   std::uint64_t received() const { return received_.load(); }
+  // Requested deadline misses while the topic flowed: a gap between two samples longer than the deadline. Those
+  // outside the stream (before its first sample, while the stack starts, and after its last, while it stops) are
+  // counted apart: they say nothing about the chain.
   std::uint64_t requestedDeadlineMisses() const { return requested_deadline_misses_.load(); }
+  std::uint64_t deadlineMissesOutsideStream() const { return misses_before_stream_.load() + misses_pending_.load(); }
   int aliveWriters() const { return shm_ ? shm_->writers() : alive_writers_.load(); }
   bool viaChainChannel() const { return shm_ != nullptr; }
   // A Polled reader on the chain channel: delivers the newest sample if it is new, on the caller's thread (the
@@ -129,6 +133,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       ++received_;
+      if (misses_pending_.load(std::memory_order_relaxed) > 0) requested_deadline_misses_ += misses_pending_.exchange(0);
       if (on_sample_) on_sample_(sample_);
     }
   }
@@ -138,7 +143,10 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   }
   void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
                                     const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
-    ++requested_deadline_misses_;
+    if (received_.load() == 0)
+      ++misses_before_stream_;
+    else
+      ++misses_pending_;  // in the stream once another sample follows; after its end otherwise
   }
   void on_liveliness_changed(eprosima::fastdds::dds::DataReader*,
                              const eprosima::fastdds::dds::LivelinessChangedStatus& s) override {
@@ -167,6 +175,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   std::atomic<int> alive_writers_{0};
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> requested_deadline_misses_{0};
+  std::atomic<std::uint64_t> misses_before_stream_{0}, misses_pending_{0};
 };
 
 // Waits until `ready()` holds or the timeout passes; returns whether it held.

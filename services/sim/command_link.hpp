@@ -46,6 +46,7 @@ class CommandLink {
   const LatencyStats& latencyUs() const { return latency_us_; }
   int matchedWriters() const { return reader_.matched(); }
   std::uint64_t requestedDeadlineMisses() const { return reader_.requestedDeadlineMisses(); }
+  std::uint64_t deadlineMissesOutsideStream() const { return reader_.deadlineMissesOutsideStream(); }
 
  private:
   void onCommand(const msg::JointCommand& m);

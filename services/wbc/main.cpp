@@ -137,7 +137,7 @@ static int toolMain(int argc, char** argv) {
 
   std::lock_guard<std::mutex> lock(mutex);
   ctx.writeSummary(figures.summaryJson(node->controller(), join, state_reader.requestedDeadlineMisses(),
-                                       tuning.summaryJson()));
+                                       state_reader.deadlineMissesOutsideStream(), tuning.summaryJson()));
   return 0;
 }
 

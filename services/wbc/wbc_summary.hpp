@@ -20,9 +20,11 @@ class WbcFigures {
     if (d.status != qp::QpStatus::Optimal) ++non_optimal_;
     if (d.iterations > max_iterations_) max_iterations_ = d.iterations;
   }
+  // `deadline_misses`: RobotState's while it flowed, `deadline_misses_outside_stream`: before and after (topic_io.hpp);
   // `live_changes`: LiveTuning::summaryJson().
   std::string summaryJson(const wbc::WholeBodyController& controller, const TickJoin& join,
-                          std::uint64_t deadline_misses, const std::string& live_changes) const;
+                          std::uint64_t deadline_misses, std::uint64_t deadline_misses_outside_stream,
+                          const std::string& live_changes) const;
 
  private:
   std::uint64_t non_optimal_ = 0;

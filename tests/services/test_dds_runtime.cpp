@@ -1,5 +1,6 @@
 // The DDS runtime over loopback: profiles load, typed samples flow between two participants on a private
-// domain, the 3 ms deadline is counted once the writer stops, and bad inputs give clear errors.
+// domain, the 3 ms deadline is counted once the writer stops (outside the stream until a sample follows the gap),
+// and bad inputs give clear errors.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -44,9 +45,18 @@ TEST(DdsRuntime, SamplesFlowInOrderAndDeadlineMissesAreCounted) {
   EXPECT_GE(reader.received(), 190u);  // best effort on loopback: at most a handful lost on a busy machine
   EXPECT_EQ(out_of_order.load(), 0u);
   const auto misses_while_flowing = reader.requestedDeadlineMisses();
-  // The writer stops: the 3 ms deadline must fire (about every 2 ms, docs/dds.md#deadline-and-liveliness-timing).
+  const auto outside_while_flowing = reader.deadlineMissesOutsideStream();
+  // The writer stops: the 3 ms deadline must fire (about every 2 ms, docs/dds.md#deadline-and-liveliness-timing),
+  // counted outside the stream (a stopping stack), not as the chain's misses.
   std::this_thread::sleep_for(50ms);
-  EXPECT_GT(reader.requestedDeadlineMisses(), misses_while_flowing + 5);
+  const auto outside_after_stop = reader.deadlineMissesOutsideStream();
+  EXPECT_GT(outside_after_stop, outside_while_flowing + 5);
+  EXPECT_EQ(reader.requestedDeadlineMisses(), misses_while_flowing);
+  // A sample after the gap: the gap was inside the stream after all, and its misses move to the chain's count.
+  m.tick(201);
+  ASSERT_TRUE(writer.write(m));
+  ASSERT_TRUE(waitUntil([&] { return last_tick.load() == 201; }, 2000ms));
+  EXPECT_GE(reader.requestedDeadlineMisses(), misses_while_flowing + (outside_after_stop - outside_while_flowing));
 }
 
 TEST(DdsRuntime, BadDomainAndMissingProfilesAreClearErrors) {

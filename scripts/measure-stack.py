@@ -103,7 +103,8 @@ def run_stack(args, tmp, scenario, mode, tag, extra=(), record=False, hops=False
     if record and rawlog.exists():
         rawlog.unlink()
     sim = dict(summary["services"]["mft-sim"])
-    for key in ("deadline_misses", "sensor_to_command_latency_us", "wbc_tick_us", "chain_cpu"):
+    for key in ("deadline_misses", "deadline_misses_by_service", "sensor_to_command_latency_us", "wbc_tick_us",
+                "chain_cpu", "chain_transport"):
         sim["run_" + key] = summary.get(key)  # the supervisor's figures over every service
     if hops:
         sim["hop_table"] = hop_table_module().hop_table(run_dir)
@@ -198,7 +199,9 @@ def measure(args, tmp):
                            # --stall-probe which of them fell in a stall of the machine
                            "sim_deadline_misses": s.get("deadline_misses"),
                            "sim_misses_during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
-                           "sim_misses_unexplained": s.get("deadline_misses_unexplained")}
+                           "sim_misses_unexplained": s.get("deadline_misses_unexplained"),
+                           # every service's: the readers' while their topic flowed, and outside it (start, stop)
+                           "deadline_misses_by_service": s["run_deadline_misses_by_service"]}
     if not args.skip_wakeup:
         out["machine_wakeup"] = run_wakeup_probe(args)
     out["load_average_after"] = load_average()
@@ -250,6 +253,11 @@ def print_report(out):
               f"simulator), of the simulator {rt['sim_deadline_misses']}"
               + (f": {rt['sim_misses_during_cpu_stalls']} during CPU stalls, {rt['sim_misses_unexplained']} unexplained"
                  if rt.get("sim_misses_unexplained") is not None else ""))
+        readers = ", ".join(f"{name} {m.get('reader')} ({m.get('gaps_over_deadline')} measured gaps; "
+                            f"+{m.get('outside_stream')} at start/stop)"
+                            for name, m in (rt.get("deadline_misses_by_service") or {}).items())
+        print(f"  readers' DDS deadline misses while their topic flowed (of them, gaps over the deadline measured by "
+              f"the reader; outside the stream: the stack starting, stopping): {readers}")
     if "machine_wakeup" in out:
         w = out["machine_wakeup"]
         timers = ", ".join(f"{cpu} p50 {t['p50']:.1f} p99 {t['p99']:.1f} max {t['max']:.0f}" for cpu, t in w["timer_late_us"].items())

@@ -28,16 +28,20 @@ def report_unwritten(not_written):
 def deadline_misses_by_service(stack):
     """Every service's deadline misses: the simulator's watchdog (those in a CPU stall of the machine apart, with
     --stall-probe) and each chain reader's while its topic flowed; the readers' misses before the first sample and
-    after the last (the stack starting and stopping) apart, as `outside_stream`."""
+    after the last (the stack starting and stopping) apart, as `outside_stream`, and the gaps between samples over
+    the deadline that the reader measured itself (`gaps_over_deadline`: the rest of `reader` is Fast DDS's timer
+    firing early; services/runtime/deadline_counts.hpp)."""
     out = {}
     for name, svc in stack.services.items():
         s = svc.summary() or {}
         if name == "mft-sim":
             out[name] = {"watchdog": s.get("deadline_misses"), "during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
                          "reader": s.get("reader_deadline_misses"),
-                         "outside_stream": s.get("reader_deadline_misses_outside_stream")}
+                         "outside_stream": s.get("reader_deadline_misses_outside_stream"),
+                         "gaps_over_deadline": s.get("reader_gaps_over_deadline")}
         elif "deadline_misses" in s:
-            out[name] = {"reader": s.get("deadline_misses"), "outside_stream": s.get("deadline_misses_outside_stream")}
+            out[name] = {"reader": s.get("deadline_misses"), "outside_stream": s.get("deadline_misses_outside_stream"),
+                         "gaps_over_deadline": s.get("gaps_over_deadline")}
     return out
 
 

@@ -92,8 +92,8 @@ static int toolMain(int argc, char** argv) {
   w.beginObject().field("service", "mft-estimator").field("mode", ctx.scenario().estimator);
   w.field("ticks", join.ticks()).field("last_tick", join.lastTick());
   join.writeCounts(w);
-  w.field("deadline_misses", sensor_reader.requestedDeadlineMisses());
-  w.field("deadline_misses_outside_stream", sensor_reader.deadlineMissesOutsideStream()).key("update_time_us").raw(update_us.json());
+  services::writeDeadlineFields(w, sensor_reader.deadlineCounts());
+  w.key("update_time_us").raw(update_us.json());
   ctx.writeSummary(w.endObject().str());
   return 0;
 }

@@ -115,8 +115,8 @@ static int toolMain(int argc, char** argv) {
   w.key("operator_commands");
   inbox.writeCounts(w);
   join.writeCounts(w);
-  w.field("deadline_misses", state_reader.requestedDeadlineMisses());
-  w.field("deadline_misses_outside_stream", state_reader.deadlineMissesOutsideStream()).key("update_time_us").raw(update_us.json());
+  services::writeDeadlineFields(w, state_reader.deadlineCounts());
+  w.key("update_time_us").raw(update_us.json());
   w.key("live_changes").raw(tuning.summaryJson());
   ctx.writeSummary(w.endObject().str());
   return 0;

@@ -18,10 +18,19 @@
 #include <functional>
 #include <memory>
 #include <thread>
+#include <type_traits>
+
+#include <time.h>
 
 #include "services/runtime/dds_participant.hpp"
+#include "services/runtime/deadline_counts.hpp"
 
 namespace mft::services {
+
+template <class M, class = void>
+struct HasTickField : std::false_type {};
+template <class M>
+struct HasTickField<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
 
 template <class Msg, class PubSubType>
 class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
@@ -105,6 +114,9 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     }
     reader_ = subscriber_->create_datareader_with_profile(topic, profile, this);
     if (!reader_) throw DdsError("cannot create a reader on " + topic_name + " with profile " + profile);
+    const auto& period = reader_->get_qos().deadline().period;
+    if (period != eprosima::fastrtps::c_TimeInfinite)
+      deadline_ns_ = static_cast<std::int64_t>(period.seconds) * 1000000000 + period.nanosec;
   }
   ~TopicReader() override {
     shm_.reset();  // joins its thread before the callback's captures go
@@ -116,10 +128,18 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   int matched() const { return shm_ ? shm_->writers() : matched_.load(); }
   std::uint64_t received() const { return received_.load(); }
   // Requested deadline misses while the topic flowed: a gap between two samples longer than the deadline. Those
-  // outside the stream (before its first sample, while the stack starts, and after its last, while it stops) are
-  // counted apart: they say nothing about the chain.
+  // outside the stream (before it starts, at the first sample of a second tick, while the stack starts; after its
+  // last sample, while the stack stops) are counted apart: they say nothing about the chain. Readers with a
+  // deadline (the realtime chain's) only.
   std::uint64_t requestedDeadlineMisses() const { return requested_deadline_misses_.load(); }
   std::uint64_t deadlineMissesOutsideStream() const { return misses_before_stream_.load() + misses_pending_.load(); }
+  // The same measured here: gaps between two consecutive samples' arrivals longer than the deadline period (0
+  // without a deadline). Fast DDS's timer fires up to a millisecond early (docs/dds.md#deadline-and-liveliness-timing),
+  // so its count above includes misses no sample gap shows.
+  std::uint64_t gapsOverDeadline() const { return gaps_over_deadline_.load(); }
+  DeadlineCounts deadlineCounts() const {
+    return {requestedDeadlineMisses(), deadlineMissesOutsideStream(), gapsOverDeadline()};
+  }
   int aliveWriters() const { return shm_ ? shm_->writers() : alive_writers_.load(); }
   bool viaChainChannel() const { return shm_ != nullptr; }
   // A Polled reader on the chain channel: delivers the newest sample if it is new, on the caller's thread (the
@@ -133,7 +153,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
       ++received_;
-      if (misses_pending_.load(std::memory_order_relaxed) > 0) requested_deadline_misses_ += misses_pending_.exchange(0);
+      if (deadline_ns_ > 0) followStream();
       if (on_sample_) on_sample_(sample_);
     }
   }
@@ -143,7 +163,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   }
   void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
                                     const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
-    if (received_.load() == 0)
+    if (!stream_started_.load())
       ++misses_before_stream_;
     else
       ++misses_pending_;  // in the stream once another sample follows; after its end otherwise
@@ -154,6 +174,24 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   }
 
  private:
+  // The stream starts at the first sample of a second tick: before it, the simulator re-sends tick 0 until the
+  // chain answers (realtime start-up), and those gaps are the stack starting, not the chain missing a deadline.
+  void followStream() {
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const std::int64_t ns = static_cast<std::int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
+    const bool was_flowing = stream_started_.load(std::memory_order_relaxed);
+    if (was_flowing && ns - last_arrival_ns_ > deadline_ns_) ++gaps_over_deadline_;
+    if (was_flowing && misses_pending_.load(std::memory_order_relaxed) > 0)
+      requested_deadline_misses_ += misses_pending_.exchange(0);
+    if constexpr (HasTickField<Msg>::value) {
+      if (received_.load(std::memory_order_relaxed) == 1) first_tick_ = sample_.tick();
+      if (!was_flowing && sample_.tick() != first_tick_) stream_started_.store(true);
+    } else {
+      stream_started_.store(true);
+    }
+    last_arrival_ns_ = ns;
+  }
   void onBytes(const unsigned char* bytes, std::size_t size) {
     if (size > payload_.max_size) return;
     std::memcpy(payload_.data, bytes, size);
@@ -176,6 +214,10 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   std::atomic<std::uint64_t> received_{0};
   std::atomic<std::uint64_t> requested_deadline_misses_{0};
   std::atomic<std::uint64_t> misses_before_stream_{0}, misses_pending_{0};
+  std::int64_t deadline_ns_ = 0, last_arrival_ns_ = 0;  // last_arrival_ns_, first_tick_: the receive thread's only
+  std::uint64_t first_tick_ = 0;
+  std::atomic<bool> stream_started_{false};
+  std::atomic<std::uint64_t> gaps_over_deadline_{0};
 };
 
 // Waits until `ready()` holds or the timeout passes; returns whether it held.

@@ -45,8 +45,7 @@ class CommandLink {
   const chain::ActuatorDriver& driver() const { return driver_; }  // under mutex()
   const LatencyStats& latencyUs() const { return latency_us_; }
   int matchedWriters() const { return reader_.matched(); }
-  std::uint64_t requestedDeadlineMisses() const { return reader_.requestedDeadlineMisses(); }
-  std::uint64_t deadlineMissesOutsideStream() const { return reader_.deadlineMissesOutsideStream(); }
+  DeadlineCounts deadlineCounts() const { return reader_.deadlineCounts(); }
 
  private:
   void onCommand(const msg::JointCommand& m);

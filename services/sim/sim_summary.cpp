@@ -54,8 +54,7 @@ std::string simSummaryJson(const SimRun& r) {
   w.field("deadline_misses", watchdog.deadlineMisses()).field("lost_commands", watchdog.lostCommands());
   w.field("damping_ticks", driver.dampingTicks()).field("startup_ticks", driver.startupTicks());
   w.field("lockstep_resends", r.resends).field("watchdog_recoveries", watchdog.recoveries());
-  w.field("reader_deadline_misses", r.link.requestedDeadlineMisses());
-  w.field("reader_deadline_misses_outside_stream", r.link.deadlineMissesOutsideStream());
+  writeDeadlineFields(w, r.link.deadlineCounts(), "reader_");
   w.key("base_height_error_m").beginObject().fixedField("rms", monitor.heightError().rms(), 6);
   w.fixedField("max", monitor.heightError().max_abs, 6).endObject();
   w.key("pitch_error_rad").beginObject().fixedField("rms", monitor.pitchError().rms(), 6);

@@ -136,8 +136,7 @@ static int toolMain(int argc, char** argv) {
   while (!services::shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
 
   std::lock_guard<std::mutex> lock(mutex);
-  ctx.writeSummary(figures.summaryJson(node->controller(), join, state_reader.requestedDeadlineMisses(),
-                                       state_reader.deadlineMissesOutsideStream(), tuning.summaryJson()));
+  ctx.writeSummary(figures.summaryJson(node->controller(), join, state_reader.deadlineCounts(), tuning.summaryJson()));
   return 0;
 }
 

@@ -5,8 +5,7 @@
 namespace mft::services {
 
 std::string WbcFigures::summaryJson(const wbc::WholeBodyController& controller, const TickJoin& join,
-                                    std::uint64_t deadline_misses, std::uint64_t deadline_misses_outside_stream,
-                                    const std::string& live_changes) const {
+                                    const DeadlineCounts& deadlines, const std::string& live_changes) const {
   const auto& s = controller.safety().counters();
   config::JsonWriter w;
   w.beginObject().field("service", "mft-wbc").field("variant", wbc::toString(controller.variant()));
@@ -16,7 +15,7 @@ std::string WbcFigures::summaryJson(const wbc::WholeBodyController& controller, 
   w.field("solver_failure", s.solver_failure).field("nonfinite_output", s.nonfinite_output);
   w.field("hold_ticks", s.hold_ticks).field("damping_ticks", s.damping_ticks).endObject();
   join.writeCounts(w);
-  w.field("deadline_misses", deadline_misses).field("deadline_misses_outside_stream", deadline_misses_outside_stream);
+  writeDeadlineFields(w, deadlines);
   w.key("solve_time_us").raw(solve_us_.json());
   w.key("tick_time_us").raw(tick_us_.json()).key("live_changes").raw(live_changes);
   return w.endObject().str();

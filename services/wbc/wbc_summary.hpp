@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "services/runtime/deadline_counts.hpp"
 #include "services/runtime/latency_stats.hpp"
 #include "services/runtime/tick_join.hpp"
 #include "wbc/whole_body_controller.hpp"
@@ -20,11 +21,9 @@ class WbcFigures {
     if (d.status != qp::QpStatus::Optimal) ++non_optimal_;
     if (d.iterations > max_iterations_) max_iterations_ = d.iterations;
   }
-  // `deadline_misses`: RobotState's while it flowed, `deadline_misses_outside_stream`: before and after (topic_io.hpp);
-  // `live_changes`: LiveTuning::summaryJson().
+  // `deadlines`: RobotState's reader's; `live_changes`: LiveTuning::summaryJson().
   std::string summaryJson(const wbc::WholeBodyController& controller, const TickJoin& join,
-                          std::uint64_t deadline_misses, std::uint64_t deadline_misses_outside_stream,
-                          const std::string& live_changes) const;
+                          const DeadlineCounts& deadlines, const std::string& live_changes) const;
 
  private:
   std::uint64_t non_optimal_ = 0;

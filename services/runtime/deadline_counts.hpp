@@ -1,0 +1,24 @@
+#pragma once
+// A chain reader's deadline misses, each explained (topic_io.hpp): those Fast DDS counted while the topic flowed
+// (a gap between two samples, or its timer firing early), those outside the stream (before the first sample while
+// the stack starts, after the last while it stops), and the gaps over the deadline measured on the reader's own
+// clock from the samples' arrivals. In-stream misses without a measured gap are the timer's.
+#include <cstdint>
+#include <string>
+
+#include "model/config/json_writer.hpp"
+
+namespace mft::services {
+
+struct DeadlineCounts {
+  std::uint64_t in_stream = 0, outside_stream = 0, gaps_over_deadline = 0;
+};
+
+// Fields of the summary object being written: <prefix>deadline_misses, <prefix>deadline_misses_outside_stream,
+// <prefix>gaps_over_deadline.
+inline void writeDeadlineFields(config::JsonWriter& w, const DeadlineCounts& c, const std::string& prefix = "") {
+  w.field(prefix + "deadline_misses", c.in_stream).field(prefix + "deadline_misses_outside_stream", c.outside_stream);
+  w.field(prefix + "gaps_over_deadline", c.gaps_over_deadline);
+}
+
+}  // namespace mft::services

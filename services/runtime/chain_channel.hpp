@@ -1,5 +1,5 @@
 #pragma once
-// The lockstep chain's shared-memory channel (docs/loop-benchmark.md#the-shared-memory-chain-channel): the topics
+// The lockstep chain's shared-memory channel (docs/loop-benchmark.md, "The shared-memory chain channel"): the topics
 // the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics go
 // between the processes of one stack (the four chain services and the recorder) through a POSIX shared-memory
 // segment the supervisor names, instead of through the DDS stack. Each topic has one slot: a ring of the last

@@ -74,9 +74,9 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
 def chain_shm_name(args, multi_host):
     """The shared-memory segment of this stack's lockstep chain (--chain-transport shm, the default), or None:
     realtime keeps DDS (a restarted peer must rejoin), --secure must not bypass access control, and --stack puts
-    the services on different hosts."""
+    the services on different hosts; a machine without a writable /dev/shm (some containers) keeps DDS too."""
     if args.mode != "lockstep" or getattr(args, "chain_transport", "shm") != "shm" or multi_host \
-            or getattr(args, "secure", None):
+            or getattr(args, "secure", None) or not os.access("/dev/shm", os.W_OK):
         return None
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 

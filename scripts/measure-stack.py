@@ -253,8 +253,8 @@ def print_report(out):
               f"simulator), of the simulator {rt['sim_deadline_misses']}"
               + (f": {rt['sim_misses_during_cpu_stalls']} during CPU stalls, {rt['sim_misses_unexplained']} unexplained"
                  if rt.get("sim_misses_unexplained") is not None else ""))
-        readers = ", ".join(f"{name} {m.get('reader')} ({m.get('gaps_over_deadline')} measured gaps; "
-                            f"+{m.get('outside_stream')} at start/stop)"
+        readers = ", ".join(f"{name} {m.get('reader')} ({m.get('gaps_over_deadline')} measured gaps, "
+                            f"{m.get('gaps_during_cpu_stalls')} of them in CPU stalls; +{m.get('outside_stream')} at start/stop)"
                             for name, m in (rt.get("deadline_misses_by_service") or {}).items())
         print(f"  readers' DDS deadline misses while their topic flowed (of them, gaps over the deadline measured by "
               f"the reader; outside the stream: the stack starting, stopping): {readers}")

@@ -25,23 +25,51 @@ def report_unwritten(not_written):
               file=sys.stderr, flush=True)
 
 
+STALL_PROBE_PERIOD_NS = 1_000_000  # mft-sim --stall-probe-us 1000, as the supervisor starts it
+READER_DEADLINE_NS = 3_000_000     # the control_reader profile's deadline (config/dds_profiles.xml)
+
+
+def stalled_within(stalls, t0, t1):
+    """Nanoseconds of [t0, t1] during which some CPU stood still: the union of the stall windows overlapping it."""
+    hits = sorted((max(a, t0), min(b, t1)) for a, b in stalls if b > t0 and a < t1)
+    total, end = 0, t0
+    for a, b in hits:
+        a = max(a, end)
+        if b > a:
+            total, end = total + b - a, b
+    return total
+
+
+def gaps_in_stalls(gaps, stalls):
+    """How many of a reader's gaps over its deadline the machine explains, by the simulator's rule for its own misses
+    (services/runtime/stall_probe.hpp): some CPU stood still for at least half the deadline during the gap (widened
+    by one probe period on each side, as a stall is recorded from the first probe wake-up it delayed)."""
+    return sum(1 for a, b in gaps
+               if 2 * stalled_within(stalls, a - STALL_PROBE_PERIOD_NS, b + STALL_PROBE_PERIOD_NS) >= READER_DEADLINE_NS)
+
+
 def deadline_misses_by_service(stack):
     """Every service's deadline misses: the simulator's watchdog (those in a CPU stall of the machine apart, with
-    --stall-probe) and each chain reader's while its topic flowed; the readers' misses before the first sample and
-    after the last (the stack starting and stopping) apart, as `outside_stream`, and the gaps between samples over
-    the deadline that the reader measured itself (`gaps_over_deadline`: the rest of `reader` is Fast DDS's timer
-    firing early; services/runtime/deadline_counts.hpp)."""
+    --stall-probe) and each chain reader's while its topic flowed; the readers' misses before the stream starts and
+    after it ends (the stack starting and stopping) apart, as `outside_stream`; the gaps between samples over the
+    deadline that the reader measured itself (`gaps_over_deadline`: the rest of `reader` is Fast DDS's timer firing
+    early; services/runtime/deadline_counts.hpp), and with --stall-probe how many of those fell in a CPU stall of
+    the machine (`gaps_during_cpu_stalls`; the others are the chain's)."""
+    sim = stack.services["mft-sim"].summary() if "mft-sim" in stack.services else None
+    stalls = ((sim or {}).get("cpu_stalls") or {}).get("windows_ns")
     out = {}
     for name, svc in stack.services.items():
         s = svc.summary() or {}
+        prefix = "reader_" if name == "mft-sim" else ""
+        if prefix + "deadline_misses" not in s:
+            continue
+        gaps = s.get(prefix + "gap_windows_ns") or []
+        m = {"reader": s.get(prefix + "deadline_misses"), "outside_stream": s.get(prefix + "deadline_misses_outside_stream"),
+             "gaps_over_deadline": s.get(prefix + "gaps_over_deadline"),
+             "gaps_during_cpu_stalls": gaps_in_stalls(gaps, stalls) if stalls is not None else None}
         if name == "mft-sim":
-            out[name] = {"watchdog": s.get("deadline_misses"), "during_cpu_stalls": s.get("deadline_misses_during_cpu_stalls"),
-                         "reader": s.get("reader_deadline_misses"),
-                         "outside_stream": s.get("reader_deadline_misses_outside_stream"),
-                         "gaps_over_deadline": s.get("reader_gaps_over_deadline")}
-        elif "deadline_misses" in s:
-            out[name] = {"reader": s.get("deadline_misses"), "outside_stream": s.get("deadline_misses_outside_stream"),
-                         "gaps_over_deadline": s.get("gaps_over_deadline")}
+            m = dict(watchdog=s.get("deadline_misses"), during_cpu_stalls=s.get("deadline_misses_during_cpu_stalls"), **m)
+        out[name] = m
     return out
 
 

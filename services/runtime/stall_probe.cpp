@@ -92,6 +92,11 @@ std::int64_t StallProbe::stalledWhileWaitingNs(std::int64_t deadline_ns, std::in
   return stalledWithinNs(deadline_ns - timeout_ns - period_ns, deadline_ns + period_ns);
 }
 
+std::vector<std::pair<std::int64_t, std::int64_t>> StallProbe::stallWindows() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return {ring_.begin(), ring_.begin() + static_cast<std::ptrdiff_t>(count_)};
+}
+
 std::uint64_t StallProbe::stalls() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return stalls_;

@@ -37,6 +37,9 @@ class StallProbe {
   // every tick, which the damping totals show).
   static bool explainsMiss(std::int64_t stalled_ns, std::int64_t timeout_ns) { return stalled_ns * 2 >= timeout_ns; }
   std::uint64_t stalls() const;
+  // The stalls kept [from, to) ns (steady_clock, which every process shares): the supervisor judges the other
+  // services' deadline misses against them.
+  std::vector<std::pair<std::int64_t, std::int64_t>> stallWindows() const;
   double maxStallMs() const;
   double totalStallMs() const;
   int cpus() const { return static_cast<int>(threads_.size()); }

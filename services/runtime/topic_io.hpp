@@ -12,11 +12,14 @@
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
 #include <fastdds/dds/subscriber/SampleInfo.hpp>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <type_traits>
 
@@ -138,7 +141,10 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   // so its count above includes misses no sample gap shows.
   std::uint64_t gapsOverDeadline() const { return gaps_over_deadline_.load(); }
   DeadlineCounts deadlineCounts() const {
-    return {requestedDeadlineMisses(), deadlineMissesOutsideStream(), gapsOverDeadline()};
+    DeadlineCounts c{requestedDeadlineMisses(), deadlineMissesOutsideStream(), gapsOverDeadline(), {}};
+    std::lock_guard<std::mutex> lock(gap_mutex_);
+    c.gap_windows_ns.assign(gap_windows_.begin(), gap_windows_.begin() + static_cast<std::ptrdiff_t>(gap_windows_kept_));
+    return c;
   }
   int aliveWriters() const { return shm_ ? shm_->writers() : alive_writers_.load(); }
   bool viaChainChannel() const { return shm_ != nullptr; }
@@ -181,7 +187,12 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     clock_gettime(CLOCK_MONOTONIC, &now);
     const std::int64_t ns = static_cast<std::int64_t>(now.tv_sec) * 1000000000 + now.tv_nsec;
     const bool was_flowing = stream_started_.load(std::memory_order_relaxed);
-    if (was_flowing && ns - last_arrival_ns_ > deadline_ns_) ++gaps_over_deadline_;
+    if (was_flowing && ns - last_arrival_ns_ > deadline_ns_) {
+      std::lock_guard<std::mutex> lock(gap_mutex_);  // only at a gap: the 1 kHz path takes no lock
+      gap_windows_[gaps_over_deadline_.load() % gap_windows_.size()] = {last_arrival_ns_, ns};
+      gap_windows_kept_ = std::min(gap_windows_kept_ + 1, gap_windows_.size());
+      ++gaps_over_deadline_;
+    }
     if (was_flowing && misses_pending_.load(std::memory_order_relaxed) > 0)
       requested_deadline_misses_ += misses_pending_.exchange(0);
     if constexpr (HasTickField<Msg>::value) {
@@ -218,6 +229,9 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   std::uint64_t first_tick_ = 0;
   std::atomic<bool> stream_started_{false};
   std::atomic<std::uint64_t> gaps_over_deadline_{0};
+  mutable std::mutex gap_mutex_;
+  std::array<std::pair<std::int64_t, std::int64_t>, 256> gap_windows_{};  // the last 256 gaps
+  std::size_t gap_windows_kept_ = 0;
 };
 
 // Waits until `ready()` holds or the timeout passes; returns whether it held.

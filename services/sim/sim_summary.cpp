@@ -29,7 +29,9 @@ void writeStalls(config::JsonWriter& w, const StallProbe& probe, const chain::Ac
   const std::uint64_t misses = driver.watchdog().deadlineMisses();
   w.key("cpu_stalls").beginObject().field("probe_cpus", probe.cpus()).field("fifo", probe.realtimePriority());
   w.field("count", probe.stalls()).fixedField("max_ms", probe.maxStallMs(), 3).fixedField("total_ms", probe.totalStallMs(), 3);
-  w.endObject();
+  w.key("windows_ns").beginArray();
+  for (const auto& [from, to] : probe.stallWindows()) w.beginArray().value(from).value(to).endArray();
+  w.endArray().endObject();
   w.field("deadline_misses_during_cpu_stalls", explained).field("deadline_misses_unexplained", misses - explained);
   w.key("miss_cpu_stalled_ms").beginArray();
   for (const double ms : stalled_ms) w.fixed(ms, 3);

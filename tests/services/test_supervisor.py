@@ -2,6 +2,7 @@
 """The supervisor's process management, against fake services that follow the service contract:
 readiness and clean end, restart with back-off in realtime, a crash failing a lockstep run, no orphan after
 `kill -9` of the supervisor, and validation errors that start nothing."""
+import argparse
 import json
 import os
 import shutil
@@ -16,7 +17,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import HELPER_FIFO_PRIORITY, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 from mftstack.errors import SupervisorError  # noqa: E402
-from mftstack.processes import chain_cpu_for, cpu_placement  # noqa: E402
+from mftstack.processes import chain_cpu_for, chain_shm_name, cpu_placement  # noqa: E402
+from mftstack.summary import gaps_in_stalls, stalled_within  # noqa: E402
 from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -92,6 +94,46 @@ class ChainPlacementTest(unittest.TestCase):
         self.assertEqual(cpu_placement(None, ["mft-wbc"]), {})
         auto = cpu_placement(allowed[0], ["mft-wbc", "mft-sim", "mft-record"], recorder_elsewhere=False)
         self.assertEqual(auto, {"mft-wbc": {allowed[0]}, "mft-sim": {allowed[0]}})  # the recorder stays free
+
+
+class ChainTransportTest(unittest.TestCase):
+    """--chain-transport: the shared-memory chain channel only for a plain lockstep stack on one machine."""
+
+    def test_only_a_plain_lockstep_stack_gets_a_channel(self):
+        def args(**kw):
+            return argparse.Namespace(**dict(dict(mode="lockstep", chain_transport="shm", secure=None, domain=7), **kw))
+        name = chain_shm_name(args(), False)
+        self.assertRegex(name, r"^/mft-chain-d7-\d+-\d+$")
+        self.assertNotEqual(name, chain_shm_name(args(domain=8), False))
+        self.assertIsNone(chain_shm_name(args(mode="realtime"), False))
+        self.assertIsNone(chain_shm_name(args(chain_transport="dds"), False))
+        self.assertIsNone(chain_shm_name(args(secure="/some/dir"), False))
+        self.assertIsNone(chain_shm_name(args(), True))  # --stack: several hosts
+
+
+class ReaderGapAttributionTest(unittest.TestCase):
+    """A reader's gap over its 3 ms deadline is the machine's when some CPU stood still for at least 1.5 ms of it
+    (the window widened by the 1 ms probe period), by the simulator's rule for its own misses."""
+    MS = 1_000_000
+
+    def test_union_of_overlapping_stalls(self):
+        ms = self.MS
+        self.assertEqual(stalled_within([], 0, 10 * ms), 0)
+        self.assertEqual(stalled_within([(2 * ms, 4 * ms)], 0, 10 * ms), 2 * ms)
+        self.assertEqual(stalled_within([(2 * ms, 4 * ms), (3 * ms, 6 * ms)], 0, 10 * ms), 4 * ms)  # overlap once
+        self.assertEqual(stalled_within([(-5 * ms, 1 * ms), (9 * ms, 20 * ms)], 0, 10 * ms), 2 * ms)  # clipped
+        self.assertEqual(stalled_within([(20 * ms, 30 * ms)], 0, 10 * ms), 0)
+
+    def test_gaps_judged_against_the_stalls(self):
+        ms = self.MS
+        stalls = [(100 * ms, 104 * ms), (200 * ms, 201 * ms)]
+        gaps = [(99 * ms, 105 * ms),   # a 4 ms stall inside: the machine's
+                (199 * ms, 203 * ms),  # 1 ms stalled: under half the deadline, the chain's
+                (300 * ms, 304 * ms),  # no stall: the chain's
+                (104.5 * ms, 108 * ms)]  # 0.5 ms of the stall in the gap, 1 ms before it in the widened window
+        self.assertEqual(gaps_in_stalls(gaps, stalls), 1)
+        self.assertEqual(gaps_in_stalls(gaps, []), 0)
+        self.assertEqual(gaps_in_stalls([], stalls), 0)
 
 
 class SupervisorTest(FakeStack, unittest.TestCase):

@@ -347,11 +347,12 @@ def main(argv=None):
                         "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "
                         "lockstep stack on the CPU its domain picks (domain modulo the CPUs allowed), realtime and "
                         "--stack unpinned; none: no pinning")
-        sp.add_argument("--chain-transport", choices=["shm", "dds"], default="shm",
-                        help="lockstep: how the chain's five topics go from service to service: shm (the default: a "
-                        "shared-memory segment per stack, a hop about one thread wake-up; DDS still carries every "
-                        "topic for the recorder and other readers) or dds (DDS alone). Realtime, --secure and --stack "
-                        "always use DDS (docs/loop-benchmark.md)")
+        sp.add_argument("--chain-transport", choices=["shm", "dds"],
+                        help="how the chain's topics go from service to service: shm (a shared-memory segment per "
+                        "stack, a hop about one thread wake-up; DDS still carries every topic to every other reader) "
+                        "or dds (DDS alone). Default: shm in lockstep, dds in realtime (where shm is an opt-in "
+                        "measured for latency; a foreign DDS writer of a chain topic, such as mft-inject, then does not "
+                        "reach the chain). --secure and --stack always use DDS (docs/loop-benchmark.md)")
         sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
                         "identities in DIR (scripts/make-security.sh; docs/security.md)")
         sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "

@@ -72,11 +72,11 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
 
 
 def chain_shm_name(args, multi_host):
-    """The shared-memory segment of this stack's lockstep chain (--chain-transport shm, the default), or None:
-    realtime keeps DDS (a restarted peer must rejoin), --secure must not bypass access control, and --stack puts
-    the services on different hosts; a machine without a writable /dev/shm (some containers) keeps DDS too."""
-    if args.mode != "lockstep" or getattr(args, "chain_transport", "shm") != "shm" or multi_host \
-            or getattr(args, "secure", None) or not os.access("/dev/shm", os.W_OK):
+    """The shared-memory segment of this stack's chain channel, or None: --chain-transport, by default shm in
+    lockstep and dds in realtime (an opt-in there); never with --secure (it would bypass access control) or --stack
+    (several hosts), nor on a machine without a writable /dev/shm (some containers)."""
+    transport = getattr(args, "chain_transport", None) or ("shm" if args.mode == "lockstep" else "dds")
+    if transport != "shm" or multi_host or getattr(args, "secure", None) or not os.access("/dev/shm", os.W_OK):
         return None
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
@@ -214,7 +214,8 @@ class Stack:
             if self.stack:
                 host = self.stack.placement[name]
                 argv = self.stack.launcher(host) + argv + ["--profiles", str(profiles[host])]
-            if self.chain_shm:  # the four chain services, and the recorder for the 1 kHz topics
+            if self.chain_shm and (name != "mft-record" or args.mode == "lockstep"):
+                # the four chain services, and in lockstep the recorder (its window keeps it inside the rings)
                 argv += ["--chain-shm", self.chain_shm]
             if name == "mft-record":
                 argv += ["--output", str(Path(args.record).resolve())] + (["--overwrite"] if args.overwrite else [])

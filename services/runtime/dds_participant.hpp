@@ -27,10 +27,18 @@ class DdsError : public std::runtime_error {
 // Highest domain id usable with the default UDP port mapping of Fast DDS (PB 7400 + DG 250 * domain < 65536).
 constexpr int kMaxDomainId = 232;
 
-// The QoS profiles of the lockstep chain (ServiceContext::chainWriterProfile/chainReaderProfile); the chain
-// channel carries only the topics written and read with these.
+// The QoS profiles of the chain (ServiceContext::chainWriterProfile/chainReaderProfile); the chain channel carries
+// only the topics written and read with these.
 inline constexpr const char* kLockstepWriterProfile = "lockstep_writer";
 inline constexpr const char* kLockstepReaderProfile = "lockstep_reader";
+inline constexpr const char* kRealtimeWriterProfile = "control_writer";
+inline constexpr const char* kRealtimeReaderProfile = "control_reader";
+inline bool isChainWriterProfile(const std::string& p) {
+  return p == kLockstepWriterProfile || p == kRealtimeWriterProfile;
+}
+inline bool isChainReaderProfile(const std::string& p) {
+  return p == kLockstepReaderProfile || p == kRealtimeReaderProfile;
+}
 
 // Validates a domain id, throwing DdsError with a message that names the valid range.
 int checkedDomainId(long domain_id);

@@ -21,7 +21,7 @@ void ServiceContext::declareOptions(CommandLine& cli) {
              "comma list; docs/profiles.md)");
   cli.option("profiles", "DDS QoS profile file (default: dds_profiles.xml of --config-dir; a multi-host stack gives "
              "each host its own: its address, its peers or discovery server, docs/distributed.md)");
-  cli.option("chain-shm", "lockstep chain services: also carry the chain's topics through this POSIX shared-memory "
+  cli.option("chain-shm", "chain services: also carry the chain's topics through this POSIX shared-memory "
              "segment (/mft-chain-…; the supervisor names one per stack; docs/loop-benchmark.md)");
   cli.flag("check-config", "load every configuration file this service reads (strict loaders) and the DDS profile "
            "file (Fast DDS's XML loader), then exit: 0 and 'configuration ok', or 2 and the error; starts nothing");
@@ -55,8 +55,6 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
     return;
   }
   const std::string chain_shm = cli.get("chain-shm");
-  if (!chain_shm.empty() && !lockstep())
-    cli.fail("--chain-shm: only in lockstep mode (realtime keeps DDS between the services)");
   if (!chain_shm.empty() && !cli.get("secure").empty())
     cli.fail("--chain-shm: not with --secure (it would bypass DDS access control)");
   if (cli.isSet("rt")) tryRealtimeScheduling(80);

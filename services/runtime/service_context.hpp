@@ -44,8 +44,8 @@ class ServiceContext {
 
   // QoS profiles of the 1 kHz chain: reliable in lockstep (every tick must arrive), deadline-watched
   // best effort in realtime.
-  std::string chainWriterProfile() const { return lockstep() ? kLockstepWriterProfile : "control_writer"; }
-  std::string chainReaderProfile() const { return lockstep() ? kLockstepReaderProfile : "control_reader"; }
+  std::string chainWriterProfile() const { return lockstep() ? kLockstepWriterProfile : kRealtimeWriterProfile; }
+  std::string chainReaderProfile() const { return lockstep() ? kLockstepReaderProfile : kRealtimeReaderProfile; }
 
   // Writes `json` (an object) to the --summary file, if one was given. Never throws.
   void writeSummary(const std::string& json) const;

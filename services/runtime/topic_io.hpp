@@ -44,7 +44,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
     if (!writer_) throw DdsError("cannot create a writer on " + topic_name + " with profile " + profile);
     publisher_ = p.publisher();
     const int slot = chainSlotIndex(topic_name);
-    if (p.chainChannel() && profile == kLockstepWriterProfile && slot >= 0) {
+    if (p.chainChannel() && isChainWriterProfile(profile) && slot >= 0) {
       if (type_.m_typeSize > ChainChannel::kSlotBytes) throw DdsError(topic_name + " does not fit a chain channel slot");
       payload_.reserve(type_.m_typeSize);
       shm_ = std::make_unique<ChainSlotWriter>(*p.chainChannel(), slot);
@@ -108,7 +108,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     auto* topic = p.topic(topic_name, new PubSubType());
     subscriber_ = p.subscriber();
     const int slot = chainSlotIndex(topic_name);
-    if (p.chainChannel() && profile == kLockstepReaderProfile && slot >= 0) {
+    if (p.chainChannel() && isChainReaderProfile(profile) && slot >= 0) {
       payload_.reserve(type_.m_typeSize);
       shm_ = std::make_unique<ChainSlotReader>(*p.chainChannel(), slot,
                                                [this](const unsigned char* bytes, std::size_t size) { onBytes(bytes, size); },

@@ -16,7 +16,8 @@ CommandLink::CommandLink(ServiceContext& ctx, HopTrace& hops, double peak_torque
       hops_(hops),
       driver_(peak_torque_Nm, watchdog_timeout_ns),
       reader_(ctx.participant(), "JointCommand", ctx.chainReaderProfile(),
-              [this](const msg::JointCommand& m) { onCommand(m); }, ChainSlotReader::Delivery::Polled) {}
+              [this](const msg::JointCommand& m) { onCommand(m); },
+              ctx.lockstep() ? ChainSlotReader::Delivery::Polled : ChainSlotReader::Delivery::Woken) {}
 
 void CommandLink::onCommand(const msg::JointCommand& m) {
   hops_.mark(2, m.tick());

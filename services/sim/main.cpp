@@ -93,7 +93,8 @@ static int toolMain(int argc, char** argv) {
                  "JointCommand writers %d)\n", start_timeout.count(), sensor_writer.matched(), link.matchedWriters());
     return 3;
   }
-  if (const auto* channel = ctx.participant().chainChannel()) channel->unlinkName();  // the chain is attached
+  const auto* channel = ctx.participant().chainChannel();
+  if (channel && ctx.lockstep()) channel->unlinkName();  // attached; in realtime a restarted service reopens it
   // Realtime starts once the chain answered tick 0: a lost discovery message can keep one hop unmatched for a
   // heartbeat period (seconds), and the robot would collapse in start-up damping meanwhile.
   if (!ctx.lockstep() && !link.awaitFirst(start_deadline, resend, publish) && !services::shutdownRequested()) {

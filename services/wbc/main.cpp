@@ -118,9 +118,10 @@ static int toolMain(int argc, char** argv) {
         services::fromMsg(m, &state);
         have_state = true;
         process(true);
-      }, services::ChainSlotReader::Delivery::Polled);
-  // On the chain channel RobotState(k) is in its slot before the planner answers it with Reference(k): the
-  // Reference takes it first, so the WBC is woken once per tick (with DDS, the state came on its own).
+      }, ctx.lockstep() ? services::ChainSlotReader::Delivery::Polled : services::ChainSlotReader::Delivery::Woken);
+  // On the lockstep chain channel RobotState(k) is in its slot before the planner answers it with Reference(k):
+  // the Reference takes it first, so the WBC is woken once per tick (with DDS, and in realtime where the WBC
+  // answers a state with an older reference, the state comes on its own).
   services::TopicReader<msg::Reference, msg::ReferencePubSubType> reference_reader(
       ctx.participant(), "Reference", ctx.chainReaderProfile(), [&](const msg::Reference& m) {
         state_reader.pollChannel();

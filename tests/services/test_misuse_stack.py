@@ -66,8 +66,7 @@ class MisuseStackTest(StackTestCase):
 
     def test_the_chain_channel_only_in_a_plain_lockstep_stack_and_nothing_left_in_dev_shm(self):
         base = [str(BIN / "mft-estimator"), "--domain", str(DOMAIN_BASE + 2), "--scenario", str(SCENARIOS / "stand.yaml")]
-        for extra, message in ((["--mode", "realtime", "--chain-shm", "/mft-chain-x"], "only in lockstep mode"),
-                               (["--chain-shm", "/mft-chain-x", "--secure", str(self.tmp)], "not with --secure"),
+        for extra, message in ((["--chain-shm", "/mft-chain-x", "--secure", str(self.tmp)], "not with --secure"),
                                (["--chain-shm", "no-leading-slash"], "expected a name like /mft-chain-NAME")):
             r = subprocess.run(base + extra, capture_output=True, text=True, timeout=60)
             self.assertEqual(r.returncode, 2, (extra, r.stdout, r.stderr))

@@ -64,7 +64,7 @@ class MisuseStackTest(StackTestCase):
         self.assertEqual(before["services"], after["services"])  # the running stack was not disturbed
         self.assertTrue(all(s["alive"] for s in after["services"].values()), after)
 
-    def test_the_chain_channel_only_in_a_plain_lockstep_stack_and_nothing_left_in_dev_shm(self):
+    def test_the_chain_channel_refuses_secure_and_bad_names_and_leaves_nothing_in_dev_shm(self):
         base = [str(BIN / "mft-estimator"), "--domain", str(DOMAIN_BASE + 2), "--scenario", str(SCENARIOS / "stand.yaml")]
         for extra, message in ((["--chain-shm", "/mft-chain-x", "--secure", str(self.tmp)], "not with --secure"),
                                (["--chain-shm", "no-leading-slash"], "expected a name like /mft-chain-NAME")):

@@ -69,16 +69,17 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
     while (reader->take_next_sample(&sample_, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK)
       if (info.valid_data) take();
   }
-  // On the chain channel: every sample written since the last call, from the caller's (the drainer's) thread.
-  void drainChannel() {
-    if (!archive_) return;
-    archive_->drain([this](const unsigned char* bytes, std::size_t size) {
+  // On the chain channel: the samples written since the last call, at most `max_samples`, from the caller's (the
+  // drainer's) thread; how many.
+  std::uint64_t drainChannel(std::uint64_t max_samples) {
+    if (!archive_) return 0;
+    return archive_->drain([this](const unsigned char* bytes, std::size_t size) {
       if (size > payload_.max_size) return;
       std::memcpy(payload_.data, bytes, size);
       payload_.length = static_cast<std::uint32_t>(size);
       payload_.pos = 0;
       if (type_.deserialize(&payload_, &sample_)) take();
-    });
+    }, max_samples);
   }
   std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
   std::uint64_t lastTick() const { return last_tick_.load(std::memory_order_relaxed); }
@@ -166,13 +167,17 @@ struct TopicTable {
   Subscription<msg::ConfigChange, msg::ConfigChangePubSubType> config_change;
 
  private:
+  // A few ticks of every ring at a time, so the recorder gets the topics interleaved as over DDS: its writer
+  // orders samples within a 5 ms window of simulated time (recorder.hpp), and a ring drained whole after a stall
+  // (up to 200 ticks) would reach it after the other rings' newer samples were written.
   void drainChannel() {
-    truth.drainChannel();
-    sensors.drainChannel();
-    state.drainChannel();
-    reference.drainChannel();
-    command.drainChannel();
-    diagnostics.drainChannel();
+    constexpr std::uint64_t kTicksPerPass = 2;
+    std::uint64_t taken = 0;
+    do {
+      taken = truth.drainChannel(kTicksPerPass) + sensors.drainChannel(kTicksPerPass) + state.drainChannel(kTicksPerPass) +
+              reference.drainChannel(kTicksPerPass) + command.drainChannel(kTicksPerPass) +
+              diagnostics.drainChannel(kTicksPerPass);
+    } while (taken > 0);
   }
   // Every millisecond, as the polling UDP path drains its sockets: a tick's six samples come in one pass.
   void drainLoop() {

@@ -168,14 +168,14 @@ ChainSlotArchive::ChainSlotArchive(ChainChannel& channel, int slot_index)
 
 ChainSlotArchive::~ChainSlotArchive() { slot_.readers.fetch_sub(1); }
 
-std::uint64_t ChainSlotArchive::drain(const Deliver& deliver) {
+std::uint64_t ChainSlotArchive::drain(const Deliver& deliver, std::uint64_t max_samples) {
   const std::uint32_t head = slot_.head.load(std::memory_order_acquire);
   if (head - cursor_ > ChainChannel::kRing) {  // lapped: the oldest entries are gone
     lost_ += head - cursor_ - ChainChannel::kRing;
     cursor_ = head - ChainChannel::kRing;
   }
   std::uint64_t delivered = 0;
-  for (; cursor_ != head; ++cursor_) {
+  for (; cursor_ != head && delivered < max_samples; ++cursor_) {
     const long size = copyChainSample(slot_, cursor_, buffer_);
     if (size < 0) {
       ++lost_;

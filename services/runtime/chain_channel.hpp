@@ -134,8 +134,8 @@ class ChainSlotArchive {
   ChainSlotArchive(const ChainSlotArchive&) = delete;
   ChainSlotArchive& operator=(const ChainSlotArchive&) = delete;
 
-  // Delivers every sample written since the last call, in order; returns how many.
-  std::uint64_t drain(const Deliver& deliver);
+  // Delivers the samples written since the last call, in order, at most `max_samples`; returns how many.
+  std::uint64_t drain(const Deliver& deliver, std::uint64_t max_samples = ~std::uint64_t{0});
   std::uint64_t lost() const { return lost_; }  // overwritten before drain() got to them
 
  private:

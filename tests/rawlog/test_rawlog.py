@@ -69,8 +69,9 @@ class RecordedLockstepRun(unittest.TestCase):
         self.assertEqual(rec["dropped_samples"], 0, rec)
         for topic in TICK_TOPICS:
             t = rec["topics"][topic]
-            self.assertEqual((t["written"], t["first"], t["last"], t["tick_gaps"], t["dropped_queue"]),
-                             (10000, 0, 9999, 0, 0), (topic, t))
+            # out_of_order 0: the file is in time order (replay stops at the first sample past --duration)
+            self.assertEqual((t["written"], t["first"], t["last"], t["tick_gaps"], t["dropped_queue"], t["out_of_order"]),
+                             (10000, 0, 9999, 0, 0, 0), (topic, t))
         code, info, err = self.info(self.rawlog)
         self.assertEqual(code, 0, err)
         self.assertEqual(info["end"], "complete")
@@ -329,6 +330,7 @@ class StarvedRecorder(unittest.TestCase):
         self.assertGreater(sim["recorder_wait_s"], 0.3)  # the simulator waited out the recorder's stop
         self.assertTrue(sim["recorder_complete"])  # the run ended once the recorder held its last tick
         self.assertEqual(rec["tick_gaps"], 0, (rec["topics"], rec.get("chain_channel_lost")))
+        self.assertEqual(sum(t["out_of_order"] for t in rec["topics"].values()), 0, rec["topics"])  # drained interleaved
         self.assertEqual(rec["dropped_samples"], 0)
         self.assertTrue(rec["chain_channel"])  # a lockstep stack's recorder takes the 1 kHz topics from the channel
         self.assertEqual(rec["chain_channel_lost"], 0)

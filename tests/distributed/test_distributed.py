@@ -185,15 +185,20 @@ class DistributedTest(StackTestCase):
         s = self.down(domain, st)
         sim, rec = s["mft-sim"], s["mft-record"]
         onset, late_ms, duration_ms = max(sim["damping_episodes"], key=lambda e: e[2])
-        self.assertGreater(duration_ms, 150.0, sim["damping_episodes"])      # the cut, not a stray late command
-        self.assertLess(duration_ms, 600.0, sim["damping_episodes"])         # commands came back after it
-        self.assertLessEqual(late_ms, 5.0, sim["damping_episodes"])          # damping <= 5 ms after the deadline
+        silent_ms = 3.0 + late_ms + duration_ms
+        detail = f"link down {cut_lo * 1e3:.0f}-{cut_hi * 1e3:.0f} ms, damping episodes {sim['damping_episodes']}"
+        self.assertGreater(duration_ms, 150.0, detail)      # the cut, not a stray late command
+        # Commands came back soon after the link did, judged against the link's real down time: the `ip` command
+        # that brings it back can itself take long on the busy VM even at SCHED_FIFO 85 (docs/distributed.md), and
+        # a fixed bound on the damping then fails the harness, not the stack. 400 ms is the old bound (600 ms of
+        # damping) less the nominal 200 ms cut; measured recoveries are -2 to +39 ms after the link.
+        self.assertLess(silent_ms - cut_hi * 1e3, 400.0, detail)
+        self.assertLessEqual(late_ms, 5.0, detail)          # damping <= 5 ms after the deadline
         self.assertGreaterEqual(sim["watchdog_recoveries"], 1)
         kept = self.check_recorder_kept_what_it_received(rec, record)
         # No command from the last one before the cut to the first one after it: the deadline (3 ms), the
         # detection delay and the damping episode. Compared with the cut, what is left is how long the stack
         # took to answer again once the link was back (within the precision of the ip commands' timing).
-        silent_ms = 3.0 + late_ms + duration_ms
         log(f"\n{CUT_SCENARIO}: ctrl link down {cut_lo * 1e3:.0f}-{cut_hi * 1e3:.0f} ms: damping {late_ms:.2f} ms after "
             f"the 3 ms deadline, for {duration_ms:.0f} ms (no command for {silent_ms:.0f} ms: recovery "
             f"{silent_ms - cut_hi * 1e3:+.0f} to {silent_ms - cut_lo * 1e3:+.0f} ms after the link); watchdog recoveries "

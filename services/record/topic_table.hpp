@@ -28,14 +28,10 @@
 #include "services/record/record_participant.hpp"
 #include "services/record/recorder.hpp"
 #include "services/runtime/chain_channel.hpp"
+#include "services/runtime/topic_io.hpp"
 #include "services/runtime/topic_names.hpp"
 
 namespace mft::services {
-
-template <class M, class = void>
-struct HasTick : std::false_type {};
-template <class M>
-struct HasTick<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
 
 // One topic into the recorder.
 template <class Msg, class PubSubType>
@@ -74,11 +70,7 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
   std::uint64_t drainChannel(std::uint64_t max_samples) {
     if (!archive_) return 0;
     return archive_->drain([this](const unsigned char* bytes, std::size_t size) {
-      if (size > payload_.max_size) return;
-      std::memcpy(payload_.data, bytes, size);
-      payload_.length = static_cast<std::uint32_t>(size);
-      payload_.pos = 0;
-      if (type_.deserialize(&payload_, &sample_)) take();
+      if (fromChainBytes(type_, payload_, bytes, size, &sample_)) take();
     }, max_samples);
   }
   std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
@@ -89,7 +81,7 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
   void take() {
     recorder_.push(rawlog::Message(sample_));
     received_.fetch_add(1, std::memory_order_relaxed);
-    if constexpr (HasTick<Msg>::value)
+    if constexpr (HasTickField<Msg>::value)
       if (sample_.tick() > last_tick_.load(std::memory_order_relaxed)) last_tick_.store(sample_.tick(), std::memory_order_relaxed);
   }
 

@@ -2,9 +2,9 @@
 // Typed topic writers and readers on a DdsParticipant, created from a named QoS profile.
 // The reader delivers every valid sample to a callback on the DDS receive thread (the cheapest path at
 // 1 kHz, docs/dds.md#transport-and-qos) and counts deadline misses, liveliness changes and matched writers.
-// In a lockstep chain service whose participant has the chain channel open (chain_channel.hpp), the chain topics
-// with the lockstep profiles go through shared memory: the writer also puts each sample in the topic's slot, and
-// the reader takes them from there only (no DDS reader: a second copy would wake it twice).
+// In a chain service whose participant has the chain channel open (chain_channel.hpp), the chain topics with the
+// chain's profiles go through shared memory: the writer also puts each sample in the topic's slot, and the reader
+// takes them from there only (no DDS reader: a second copy would wake it twice).
 #include <fastdds/rtps/common/SerializedPayload.h>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/DataWriterListener.hpp>
@@ -34,6 +34,17 @@ template <class M, class = void>
 struct HasTickField : std::false_type {};
 template <class M>
 struct HasTickField<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
+
+// A sample's CDR bytes from the chain channel into `msg`, through a payload reserved once (no allocation).
+template <class Msg, class PubSubType>
+bool fromChainBytes(PubSubType& type, eprosima::fastrtps::rtps::SerializedPayload_t& payload, const unsigned char* bytes,
+                    std::size_t size, Msg* msg) {
+  if (size > payload.max_size) return false;
+  std::memcpy(payload.data, bytes, size);
+  payload.length = static_cast<std::uint32_t>(size);
+  payload.pos = 0;
+  return type.deserialize(&payload, msg);
+}
 
 template <class Msg, class PubSubType>
 class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
@@ -204,11 +215,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
     last_arrival_ns_ = ns;
   }
   void onBytes(const unsigned char* bytes, std::size_t size) {
-    if (size > payload_.max_size) return;
-    std::memcpy(payload_.data, bytes, size);
-    payload_.length = static_cast<std::uint32_t>(size);
-    payload_.pos = 0;
-    if (!type_.deserialize(&payload_, &sample_)) return;
+    if (!fromChainBytes(type_, payload_, bytes, size, &sample_)) return;
     ++received_;
     if (on_sample_) on_sample_(sample_);
   }
@@ -217,7 +224,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   Msg sample_;  // persistent: never construct a message per cycle
   PubSubType type_;
   eprosima::fastrtps::rtps::SerializedPayload_t payload_;
-  std::unique_ptr<ChainSlotReader> shm_;  // last: its thread stops first
+  std::unique_ptr<ChainSlotReader> shm_;  // reset first in the destructor: its thread uses the members above
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   eprosima::fastdds::dds::DataReader* reader_ = nullptr;
   std::atomic<int> matched_{0};

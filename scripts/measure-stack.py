@@ -6,7 +6,8 @@ hits every measurement alike:
   * the in-process reference: mft-closedloop, the whole chain in one process (no DDS);
   * one plain lockstep run per variant through services/mft-supervisor and the real services, traced hop by
     hop (MFT_HOP_TRACE): the per-tick split into each DDS hop and each service's compute, p50/p99/max;
-  * one lockstep run recording every topic (the recording cost, against the round's first variant).
+  * one lockstep run recording every topic (the recording cost, against the round's first variant);
+  * (unless --skip-realtime) a realtime run, traced hop by hop from the sensor sample to the command.
 Then the machine's own wake-up floor (mft-wakeup: 1 kHz timer lateness per CPU, thread wake-ups on one core
 and across cores), the figure each hop and the realtime latency stand on.
 Reported: each variant's real-time factor, its ratio to the in-process speed (per round, in-process wall time
@@ -107,7 +108,7 @@ def run_stack(args, tmp, scenario, mode, tag, extra=(), record=False, hops=False
                 "chain_cpu", "chain_transport"):
         sim["run_" + key] = summary.get(key)  # the supervisor's figures over every service
     if hops:
-        sim["hop_table"] = hop_table_module().hop_table(run_dir)
+        sim["hop_table"] = hop_table_module().hop_table(run_dir, realtime=(mode == "realtime"))
     if "mft-record" in summary["services"]:
         sim["recorder_dropped_samples"] = summary["services"]["mft-record"].get("dropped_samples")
     shutil.rmtree(run_dir, ignore_errors=True)
@@ -190,7 +191,7 @@ def measure(args, tmp):
         scenario.write_text(text.replace("name: step-in-place", "name: step-in-place-long"))
         progress(f"realtime run of {args.realtime_s:g} s (load {os.getloadavg()[0]:.2f}) ...")
         extra = variants[0][1] + (["--stall-probe"] if args.stall_probe else [])
-        s = run_stack(args, tmp, scenario, "realtime", "rt", extra, timeout_s=args.realtime_s + 300)
+        s = run_stack(args, tmp, scenario, "realtime", "rt", extra, hops=not args.no_hops, timeout_s=args.realtime_s + 300)
         out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["run_deadline_misses"],
                            "sensor_to_command_latency_us": s["run_sensor_to_command_latency_us"],
                            "wbc_tick_us": s["run_wbc_tick_us"], "fell": s["fell"], "chain_cpu": s["run_chain_cpu"],
@@ -202,10 +203,36 @@ def measure(args, tmp):
                            "sim_misses_unexplained": s.get("deadline_misses_unexplained"),
                            # every service's: the readers' while their topic flowed, and outside it (start, stop)
                            "deadline_misses_by_service": s["run_deadline_misses_by_service"]}
+        if "hop_table" in s:
+            out["realtime"]["hop_table"] = s["hop_table"]
     if not args.skip_wakeup:
         out["machine_wakeup"] = run_wakeup_probe(args)
+        if "hop_table" in out.get("realtime", {}):
+            out["realtime"]["hops_against_the_floor"] = hops_against_the_floor(out["realtime"]["hop_table"],
+                                                                               out["machine_wakeup"])
     out["load_average_after"] = load_average()
     return out
+
+
+def hops_against_the_floor(table, wakeup):
+    """Each realtime hop that carries a sample from one process to the next, against the machine's own thread
+    wake-up (mft-wakeup, same run): a hop cannot beat a wake-up, so what its p99 has over the floor is the
+    transport's own share. The realtime stack is not pinned, so a hop wakes its reader on the same core or on the
+    other one: both floors are given, and the excess is taken over the larger (cross-core on a multi-core VM)."""
+    floors = {where: w["p99"] for where, w in wakeup["wakeup_us"].items()}
+    floor = max(floors.values())
+    hop_table = hop_table_module()
+    rows = []
+    for r in table["intervals"]:
+        if r["interval"] in hop_table.TRANSPORT_HOPS and r.get("count"):
+            rows.append({"hop": r["interval"], "p50": r["p50"], "p99": r["p99"], "max": r["max"],
+                         "p99_over_wakeup_floor": round(r["p99"] - floor, 1)})
+    computes = [r for r in table["intervals"] if r["interval"] not in hop_table.TRANSPORT_HOPS and r.get("count")]
+    return {"wakeup_p99_us": floors, "hops": rows,
+            # the chain's p99 if every hop cost only the floor and every compute its own p99 (an upper bound of
+            # the floor's share: p99s do not add, so this overstates what four wake-ups cost together)
+            "floor_plus_compute_p99_sum_us": round(4 * floor + sum(r["p99"] for r in computes), 1),
+            "chain_p99_us": table["tick_us"].get("p99")}
 
 
 def run_wakeup_probe(args):
@@ -239,7 +266,7 @@ def print_report(out):
               f"{v['us_per_tick_median']} us per tick; ratio to in-process {v['ratio_to_inprocess_median']} median "
               f"(per round {v['ratio_to_inprocess_per_round']}); tick re-sends {v['resends']}")
         if "hop_table" in v:
-            print(f"  per-hop table of its median run [us]:")
+            print("  per-hop table of its median run [us]:")
             hop_table.print_table(v["hop_table"])
     if "recording" in out:
         r = out["recording"]
@@ -256,6 +283,16 @@ def print_report(out):
         readers = ", ".join(f"{name} {m.get('reader')} ({m.get('gaps_over_deadline')} measured gaps, "
                             f"{m.get('gaps_during_cpu_stalls')} of them in CPU stalls; +{m.get('outside_stream')} at start/stop)"
                             for name, m in (rt.get("deadline_misses_by_service") or {}).items())
+        if "hop_table" in rt:
+            print("  per-hop table of the realtime run [us] (the sum is the sensor-to-command latency):")
+            hop_table.print_table(rt["hop_table"])
+        if "hops_against_the_floor" in rt:
+            f = rt["hops_against_the_floor"]
+            print(f"  against the machine's thread wake-up p99 {f['wakeup_p99_us']} us: "
+                  + "; ".join(f"{h['hop'].split(' ->')[0]}: p99 {h['p99']:.0f} (+{h['p99_over_wakeup_floor']:.0f})"
+                              for h in f["hops"])
+                  + f"; chain p99 {f['chain_p99_us']} us against 4 wake-ups + computes (p99 sum) "
+                  f"{f['floor_plus_compute_p99_sum_us']} us")
         print(f"  readers' DDS deadline misses while their topic flowed (of them, gaps over the deadline measured by "
               f"the reader; outside the stream: the stack starting, stopping): {readers}")
     if "machine_wakeup" in out:
@@ -297,7 +334,8 @@ def main():
     ap.add_argument("--stall-probe", action="store_true", help="realtime run with the simulator's CPU stall probe: "
                     "each deadline miss attributed to a stall of the machine or to the chain (costs ~30 us of p50)")
     ap.add_argument("--skip-wakeup", action="store_true", help="no machine wake-up probe (mft-wakeup)")
-    ap.add_argument("--no-hops", action="store_true", help="do not trace the plain lockstep runs hop by hop")
+    ap.add_argument("--no-hops", action="store_true", help="do not trace the plain lockstep runs and the realtime run "
+                    "hop by hop")
     ap.add_argument("--hops", action="store_true", help=argparse.SUPPRESS)  # the default now; kept for old commands
     ap.add_argument("--private-net", action="store_true", help="run inside a private network namespace (unshare -n)")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")

@@ -79,6 +79,27 @@ class MeasureStackTest(unittest.TestCase):
             self.assertEqual(len(table["intervals"]), 10)
         self.assertIn("1min", d["load_average_before"])
 
+    def test_the_realtime_run_is_traced_hop_by_hop_and_agrees_with_the_simulators_own_latency(self):
+        r = self.measure("--runs", "1", "--skip-recording", "--realtime-s", "3", "--domain", "205", "--json")
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+        rt = json.loads(r.stdout)["realtime"]
+        table = rt["hop_table"]
+        self.assertTrue(table["realtime"])
+        self.assertEqual(len(table["intervals"]), 7)  # sensor sample out ... command in, not the simulator's loop
+        self.assertGreater(table["ticks"], 2500)
+        total = sum(row["mean"] for row in table["intervals"])
+        self.assertAlmostEqual(total, table["tick_us"]["mean"], delta=0.02 * table["tick_us"]["mean"])
+        # Two clocks of one quantity: the hop trace's stamps (publish -> command_in) against the simulator's own
+        # SensorData-out to JointCommand-in latency, over nearly the same ticks (the trace leaves out the first 100).
+        own = rt["sensor_to_command_latency_us"]
+        self.assertGreater(own["count"], 2500)
+        self.assertAlmostEqual(table["tick_us"]["p50"], own["p50"], delta=10.0 + 0.1 * own["p50"])
+        floor = rt["hops_against_the_floor"]
+        self.assertEqual(len(floor["hops"]), 4)  # sim -> estimator -> planner -> WBC -> sim
+        worst = max(floor["wakeup_p99_us"].values())
+        for h in floor["hops"]:
+            self.assertAlmostEqual(h["p99_over_wakeup_floor"], h["p99"] - worst, delta=0.11)
+
 
 if __name__ == "__main__":
     unittest.main()

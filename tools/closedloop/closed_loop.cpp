@@ -127,6 +127,8 @@ void ClosedLoop::accumulate() {
     last_step_seen_ = plan.step_index;
   }
   s.steps = plan.step_index;
+  s.final_base_x = truth.q[model::kBaseX];
+  s.max_base_x = s.ticks <= 1 ? s.final_base_x : std::max(s.max_base_x, s.final_base_x);
 
   // The window: statistics of the truth after the tick, and of the estimate the controller used against the
   // truth it was computed from.
@@ -200,6 +202,7 @@ std::string RunSummary::toJson() const {
   stat("rms_pitch_rad", rms_pitch);
   stat("max_abs_pitch_rad", max_abs_pitch);
   stat("average_speed_mps", average_speed);
+  w.field("final_base_x_m", final_base_x, kDigits).field("max_base_x_m", max_base_x, kDigits);
   w.key("estimator_rms_error").beginObject();
   stat("z_m", est_rms_z);
   stat("pitch_rad", est_rms_pitch);

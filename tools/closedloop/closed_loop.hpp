@@ -74,6 +74,8 @@ struct RunSummary {
   double rms_pitch = 0.0, max_abs_pitch = 0.0;  // [rad]
   double min_base_z = 0.0, max_base_z = 0.0;
   double average_speed = 0.0;          // (x_end - x_start) / window [m/s]
+  double final_base_x = 0.0, max_base_x = 0.0;  // world x of the base at the last tick, and its largest, whole run
+                                                // (how far a terrain run got) [m]
   double est_rms_z = 0.0, est_rms_pitch = 0.0, est_rms_vx = 0.0;  // estimate - truth
   double max_mft_violation = 0.0;      // max over the window of max(A q_a - b) (truth; NaN without polytope)
   double min_lti = 1.0;

@@ -18,6 +18,8 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
   case        one push with both controllers, the paper's Fig. 6 as a PNG and a side-by-side video (case.mp4)
   terrain     blind walking over the course (board, slope, rough ground) with both controllers, Fig. 8 as a PNG
               and a side-by-side video (terrain.mp4)
+  terrain-scan  the course walked in process from many start offsets (the gait's phase at the board's edge):
+              how often each height, speed and controller gets over it; terrain_scan.md/.csv/.png
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
   worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/experiments.md)
@@ -33,17 +35,27 @@ class Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def heights_list(text):
+def _numbers(text, noun, valid, why):
+    """A comma-separated list of numbers (3 decimals), each passing `valid`, else `why` (formatted with it)."""
     try:
-        hs = [round(float(x), 3) for x in text.split(",") if x.strip()]
+        xs = [round(float(x), 3) for x in text.split(",") if x.strip()]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a comma-separated list of heights: {text!r}")
-    if not hs:
-        raise argparse.ArgumentTypeError("no height given")
-    for h in hs:
-        if not HEIGHT_RANGE[0] <= h <= HEIGHT_RANGE[1]:
-            raise argparse.ArgumentTypeError(f"height {h} m is outside the planner's window {HEIGHT_RANGE} m")
-    return hs
+        raise argparse.ArgumentTypeError(f"not a comma-separated list of {noun}s: {text!r}")
+    if not xs:
+        raise argparse.ArgumentTypeError(f"no {noun} given")
+    for x in xs:
+        if not valid(x):
+            raise argparse.ArgumentTypeError(why.format(x))
+    return xs
+
+
+def heights_list(text):
+    return _numbers(text, "height", lambda h: HEIGHT_RANGE[0] <= h <= HEIGHT_RANGE[1],
+                    "height {} m is outside the planner's window " + f"{HEIGHT_RANGE} m")
+
+
+def speeds_list(text):
+    return _numbers(text, "speed", lambda v: 0 < v <= 0.6, "speed {} m/s is outside (0, 0.6] m/s (planner.yaml max_speed_mps)")
 
 
 def controllers_list(text):
@@ -173,7 +185,7 @@ def make_setup(args):
 def build_parser():
     p = Parser(prog="mft-experiment", description=DESCRIPTION,
                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,ablation,worker}", parser_class=Parser)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,terrain-scan,ablation,worker}", parser_class=Parser)
     sub.required = True
 
     s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
@@ -221,6 +233,22 @@ def build_parser():
                         "the robot stalls on the slope; docs/experiments.md#terrain-fig-8)")
     add_common(t)
     _video.add_video_options(t)
+    from . import terrain_scan as _scan
+    ts = sub.add_parser("terrain-scan", help="the course from many start offsets: how often blind walking gets over it",
+                        description=_scan.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ts.add_argument("--heights", type=heights_list, default=[0.42, 0.44],
+                    help="reference base heights [m] (default 0.42,0.44: terrain's default and 0.44)")
+    ts.add_argument("--speeds", type=speeds_list, default=[0.25], help="commanded speeds [m/s] (default 0.25)")
+    ts.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
+    ts.add_argument("--shift-span", type=positive, default=0.10,
+                    help="the course is shifted from -SPAN to +SPAN [m] (default 0.10: more than a step)")
+    ts.add_argument("--shift-step", type=positive, default=0.01, help="offset step [m] (default 0.01)")
+    ts.add_argument("--terrain", default="course", help="terrain file under config/terrain (default course)")
+    ts.add_argument("--duration", type=positive, help="run length [s] (default: enough to pass the course)")
+    ts.add_argument("--out", help="output folder (default runs/terrain-scan-<time>)")
+    ts.add_argument("--paper-setup", action="store_true",
+                    help="without the profile kv-0.145 that terrain's runs carry (see terrain --help)")
+    add_common(ts)
     from . import ablation as _abl
     a = sub.add_parser("ablation", help="each departure from the paper's setup alone; I_max against the slack weight",
                        description=_abl.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -375,7 +403,8 @@ def main(argv=None):
                         need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
                              (("mft-record", "mft-export") if args.command in ("case", "terrain") or
                               getattr(args, "keep_rawlogs", False) else ()) +
-                             (("mft-closedloop",) if getattr(args, "inprocess", False) else ()))
+                             (("mft-closedloop",) if getattr(args, "inprocess", False) or
+                              args.command == "terrain-scan" else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
         if args.command in ("case", "terrain"):
@@ -387,6 +416,11 @@ def main(argv=None):
         if args.command == "terrain":
             from .terrain import cmd_terrain
             return cmd_terrain(args)
+        if args.command == "terrain-scan":
+            from .terrain_scan import cmd_terrain_scan
+            args.out = args.out or str(REPO / "runs" / f"terrain-scan-{time.strftime('%Y%m%d-%H%M%S')}")
+            use_snapshot(args)
+            return cmd_terrain_scan(args)
         if args.command == "ablation":
             from .ablation import cmd_ablation
             args.out = args.out or str(REPO / "runs" / f"ablation-{time.strftime('%Y%m%d-%H%M%S')}")

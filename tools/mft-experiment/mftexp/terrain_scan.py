@@ -1,0 +1,180 @@
+"""terrain-scan: how often blind walking gets over the course, over the gait's phase at the board.
+
+A blind walk meets the board's leading edge wherever the gait puts its footfalls: a foot that lands in the last
+2-3 cm before the 3 cm board brings its fore shank onto the corner (docs/experiments.md#terrain-fig-8). Where the
+footfalls fall at the edge is set by the gait's phase there, and so by how far the course starts from the robot.
+One run of `terrain` is therefore one draw. This command walks the whole course in process (mft-closedloop, the
+same configs, profiles and fall criteria as the stack) with the course shifted by each offset
+(config/terrain/<terrain>.yaml start_x_m + offset, one configuration copy per offset in OUT/config-shifts), per
+height, speed and controller, and counts the runs that crossed the board (base 0.3 m past its far edge) and
+those that traversed the course (no fall, base 0.3 m past the last obstacle, as `terrain` judges it), with each
+failed run's first body contact. Outputs: terrain_scan.md, terrain_scan.csv, terrain_scan.json and
+terrain_scan.png (one row per cell, one mark per offset)."""
+import csv
+import re
+import shutil
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+from .common import (CONTROLLER_NAMES, ExperimentError, Progress, pyplot, run_closedloop, write_report,
+                     write_yaml_scenario)
+from .terrain import course_profiles, course_segments, load_yaml
+
+CLEARANCE_M = 0.3  # "past" an obstacle: the base this far beyond its far edge, the whole robot over it
+
+
+def offsets(span_m, step_m):
+    n = int(round(span_m / step_m))
+    return [round(i * step_m, 6) for i in range(-n, n + 1)]
+
+
+def shifted_config(src, dest, terrain, offset):
+    """A copy of the configuration folder whose terrain file starts `offset` metres later (only start_x_m
+    changes)."""
+    if dest.exists():
+        shutil.rmtree(dest)
+    shutil.copytree(src, dest)
+    path = dest / "terrain" / f"{terrain}.yaml"
+    text = path.read_text()
+    start = float(load_yaml(path).get("start_x_m", 0.0))
+    new, n = re.subn(r"(?m)^start_x_m:.*$", f"start_x_m: {start + offset:.6f}", text)
+    if n != 1:
+        raise ExperimentError(f"{path}: expected one top-level start_x_m line to shift the course")
+    path.write_text(new)
+    return dest
+
+
+def scan_scenario(height, speed, controller, terrain, duration):
+    return {"name": f"terrain-scan-{controller}", "duration_s": duration, "controller": controller,
+            "description": f"mft-experiment terrain-scan: blind walking at {speed} m/s, {height} m over {terrain}",
+            "estimator": "kalman", "terrain": terrain, "initial_base_height_m": height,
+            "fall": {"base_height_below_m": 0.25, "pitch_beyond_rad": 0.8},
+            "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": height, "v_cmd_mps": 0.0},
+                         {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": height, "v_cmd_mps": 0.0},
+                         {"at_s": 2.0, "mode": "walk", "z_cmd_m": height, "v_cmd_mps": speed}]}
+
+
+def judge(run, segs, offset):
+    """crossed_board (None without a board), traversed, from the run's summary and the shifted course."""
+    boards = [s for s in segs if s[0] == "board"]
+    obstacles = [s for s in segs if s[0] != "flat"]
+    x = run["max_base_x_m"]
+    crossed = None if not boards else x >= boards[0][2] + offset + CLEARANCE_M
+    traversed = (not run["fell"]) and x >= obstacles[-1][2] + offset + CLEARANCE_M
+    return crossed, traversed
+
+
+def cmd_terrain_scan(args):
+    tfile = Path(args.config_dir) / "terrain" / f"{args.terrain}.yaml"
+    if not tfile.is_file():
+        raise ExperimentError(f"terrain file {tfile} does not exist")
+    segs = course_segments(load_yaml(tfile))
+    if not [s for s in segs if s[0] != "flat"]:
+        raise ExperimentError(f"{tfile} has no board, slope or rough segment")
+    if not 0 < args.shift_step <= args.shift_span:
+        raise ExperimentError("need 0 < --shift-step <= --shift-span")
+    if args.shift_span / args.shift_step > 200:
+        raise ExperimentError("at most 401 offsets (--shift-span / --shift-step <= 200)")
+    args.profile = course_profiles(args)
+    out = Path(args.out)
+    shifts = offsets(args.shift_span, args.shift_step)
+    course_end = [s for s in segs if s[0] != "flat"][-1][2] + CLEARANCE_M
+    cells = [(h, v, c) for h in args.heights for v in args.speeds for c in args.controllers]
+    t0 = time.monotonic()
+    configs = {o: shifted_config(Path(args.config_dir), out / "config-shifts" / f"shift{o:+.3f}", args.terrain, o)
+               for o in shifts}
+    jobs = []
+    for h, v, c in cells:
+        duration = args.duration or min(300.0, round(2.0 + (course_end + max(shifts)) / (0.5 * v) + 3.0, 1))
+        scen = out / "scenarios" / f"h{h:.3f}-v{v:.3f}-{c}.yaml"
+        scen.parent.mkdir(parents=True, exist_ok=True)
+        write_yaml_scenario(scen, scan_scenario(h, v, c, args.terrain, duration))
+        jobs += [(h, v, c, o, scen) for o in shifts]
+    progress = Progress(args.workers, quiet=args.quiet)
+    progress.note(f"{len(jobs)} runs: {len(cells)} cells x {len(shifts)} course offsets, {args.workers} at a time, "
+                  f"profiles {args.profile or 'none (the paper setup)'}")
+    left = [len(jobs)]
+
+    def one(job):
+        h, v, c, o, scen = job
+        sim, wall = run_closedloop(scen, args.bin_dir, configs[o], timeout_s=600.0, profiles=args.profile)
+        crossed, traversed = judge(sim, segs, o)
+        contact = sim.get("first_body_contact") or {}
+        row = {"height_m": h, "speed_mps": v, "controller": c, "offset_m": o, "crossed_board": crossed,
+               "traversed": traversed, "fell": sim["fell"], "fall_time_s": sim["fall_time_s"],
+               "max_base_x_m": round(sim["max_base_x_m"], 4),
+               "first_body_contact": contact.get("body"),
+               "contact_x_from_board_m": (None if contact.get("x_m") is None or not any(s[0] == "board" for s in segs)
+                                          else round(contact["x_m"] - ([s for s in segs if s[0] == "board"][0][1] + o), 4)),
+               "contact_time_s": contact.get("time_s")}
+        left[0] -= 1
+        progress.run_finished(wall, f"{h:.2f} m {v:.2f} m/s {c} offset {o:+.3f} m: "
+                                    f"{'traversed' if traversed else 'crossed the board' if crossed else 'failed'}",
+                              left[0])
+        return row
+    with ThreadPoolExecutor(max_workers=args.workers) as pool:
+        rows = list(pool.map(one, jobs))
+    summary = []
+    for h, v, c in cells:
+        rs = [r for r in rows if (r["height_m"], r["speed_mps"], r["controller"]) == (h, v, c)]
+        bodies = {}
+        for r in rs:
+            if not r["traversed"] and r["first_body_contact"]:
+                bodies[r["first_body_contact"]] = bodies.get(r["first_body_contact"], 0) + 1
+        summary.append({"height_m": h, "speed_mps": v, "controller": c, "runs": len(rs),
+                        "crossed_board": sum(bool(r["crossed_board"]) for r in rs),
+                        "traversed": sum(r["traversed"] for r in rs),
+                        "traversed_of_crossed": sum(r["traversed"] for r in rs if r["crossed_board"]),
+                        "failed_first_body_contact": bodies})
+    report = {"terrain": args.terrain, "profiles": list(args.profile), "offsets_m": shifts,
+              "clearance_m": CLEARANCE_M, "cells": summary, "runs": rows, "out": str(out)}
+    write_tables(out, report)
+    png = plot_scan(out / "terrain_scan.png", report)
+    write_report(out / "terrain_scan.json", report, png, t0, args.json)
+    if not args.json:
+        print((out / "terrain_scan.md").read_text(), end="")
+    return 0
+
+
+def write_tables(out, report):
+    with open(out / "terrain_scan.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(report["runs"][0]))
+        w.writeheader()
+        w.writerows(report["runs"])
+    o = report["offsets_m"]
+    lines = [f"# terrain-scan: {report['terrain']}, course shifted by {o[0]:+.3f} ... {o[-1]:+.3f} m "
+             f"({len(o)} offsets); profiles {', '.join(report['profiles']) or 'none (the paper setup)'}", "",
+             "| height [m] | speed [m/s] | controller | crossed the board | traversed the course | "
+             "failed runs' first body contact |", "|---|---|---|---|---|---|"]
+    for s in report["cells"]:
+        bodies = ", ".join(f"{b} {n}" for b, n in sorted(s["failed_first_body_contact"].items())) or "-"
+        lines.append(f"| {s['height_m']:.2f} | {s['speed_mps']:.2f} | {CONTROLLER_NAMES.get(s['controller'], s['controller'])} "
+                     f"| {s['crossed_board']}/{s['runs']} | {s['traversed']}/{s['runs']} | {bodies} |")
+    (out / "terrain_scan.md").write_text("\n".join(lines) + "\n")
+
+
+def plot_scan(path, report):
+    plt = pyplot()
+    cells = report["cells"]
+    fig, ax = plt.subplots(figsize=(9, 1.0 + 0.45 * len(cells)))
+    colors = {"traversed": "tab:green", "crossed": "tab:orange", "failed": "tab:red"}
+    for i, s in enumerate(cells):
+        for r in report["runs"]:
+            if (r["height_m"], r["speed_mps"], r["controller"]) != (s["height_m"], s["speed_mps"], s["controller"]):
+                continue
+            k = "traversed" if r["traversed"] else "crossed" if r["crossed_board"] else "failed"
+            ax.plot(r["offset_m"] * 100, i, "s", color=colors[k], ms=7)
+    for k, col in colors.items():
+        ax.plot([], [], "s", color=col, label={"crossed": "crossed the board, fell later"}.get(k, k))
+    ax.set_yticks(range(len(cells)))
+    ax.set_yticklabels([f"{s['height_m']:.2f} m, {s['speed_mps']:.2f} m/s, "
+                        f"{CONTROLLER_NAMES.get(s['controller'], s['controller'])}" for s in cells])
+    ax.set_xlabel("course shifted by [cm] (the gait's phase at the board's edge)")
+    ax.set_ylim(-0.7, len(cells) - 0.3)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(cells) < 4 else -0.15), ncol=3, fontsize=8)
+    ax.set_title(f"blind walking over '{report['terrain']}': outcome per course offset", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

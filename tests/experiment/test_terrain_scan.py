@@ -73,6 +73,15 @@ class TerrainScanTest(unittest.TestCase):
         self.assertIn(f"| {cell['crossed_board']}/3 | {cell['traversed']}/3 |", md)
         self.assertGreater((self.out / "terrain_scan.png").stat().st_size, 1000)
 
+    def test_the_walking_height_shows_the_contact_weights_sag(self):
+        # Table I's w_fc = 1e-3 holds the base below its command by w_fc m^2 g / (n_st w_z kp): 13.0 mm predicted in
+        # single support (docs/profiles.md, contact-weights-small; 15 mm measured stepping in place).
+        self.assertEqual(self.r.returncode, 0, self.r.stderr[-2000:])
+        (cell,) = json.loads(self.r.stdout)["cells"]
+        sag = 0.44 - cell["walking_height_on_flat_m"]
+        self.assertGreater(sag, 0.008)
+        self.assertLess(sag, 0.022)
+
     def test_bad_arguments_are_one_line(self):
         for args, expect in ((["--shift-step", "0"], "--shift-step"), (["--shift-step", "0.2"], "--shift-step"),
                              (["--speeds", "0.9"], "outside"), (["--terrain", "nowhere"], "does not exist"),

@@ -292,7 +292,8 @@ def run_closedloop(scenario_path, bin_dir, config_dir, timeout_s=600.0, profiles
     sim = {"fell": s["fell"], "fall_time_s": s["fall_time_s"] if s["fell"] else None,
            "fall_reason": s["fall_reason"] or None, "ticks": s["ticks"], "sim_time_s": s["sim_time_s"],
            "recovery": d["recovery"], "profiles": (d.get("scenario") or {}).get("profiles"),
-           "max_base_x_m": s.get("max_base_x_m"), "first_body_contact": s.get("first_body_contact")}
+           "max_base_x_m": s.get("max_base_x_m"), "first_body_contact": s.get("first_body_contact"),
+           "mean_base_z_m": s.get("mean_base_z_m")}  # over the window from --stats-from (2 s) to the end or the fall
     return sim, time.monotonic() - t0
 
 

@@ -8,7 +8,8 @@ same configs, profiles and fall criteria as the stack) with the course shifted b
 (config/terrain/<terrain>.yaml start_x_m + offset, one configuration copy per offset in OUT/config-shifts), per
 height, speed and controller, and counts the runs that crossed the board (base 0.3 m past its far edge) and
 those that traversed the course (no fall, base 0.3 m past the last obstacle, as `terrain` judges it), with each
-failed run's first body contact. Outputs: terrain_scan.md, terrain_scan.csv, terrain_scan.json and
+failed run's first body contact; and per cell, the base's mean height walking on flat ground (one 8 s run, 2-8 s),
+which shapes the legs when they reach the board. Outputs: terrain_scan.md, terrain_scan.csv, terrain_scan.json and
 terrain_scan.png (one row per cell, one mark per offset)."""
 import csv
 import re
@@ -113,7 +114,18 @@ def cmd_terrain_scan(args):
                                     f"{'traversed' if traversed else 'crossed the board' if crossed else 'failed'}",
                               left[0])
         return row
+    def flat_height(cell):
+        """The base's mean height walking on flat ground (2-8 s), the cell's setup otherwise: what shapes the legs
+        when they reach the board (with the paper's contact-force weight it sits below the command,
+        docs/profiles.md)."""
+        h, v, c = cell
+        scen = out / "scenarios" / f"flat-h{h:.3f}-v{v:.3f}-{c}.yaml"
+        write_yaml_scenario(scen, dict(scan_scenario(h, v, c, "flat", 8.0), name=f"terrain-scan-flat-{c}"))
+        sim, _ = run_closedloop(scen, args.bin_dir, args.config_dir, timeout_s=120.0, profiles=args.profile)
+        z = sim.get("mean_base_z_m")
+        return cell, None if sim["fell"] or z is None else round(z, 4)
     with ThreadPoolExecutor(max_workers=args.workers) as pool:
+        flat = dict(pool.map(flat_height, cells))
         rows = list(pool.map(one, jobs))
     summary = []
     for h, v, c in cells:
@@ -123,6 +135,7 @@ def cmd_terrain_scan(args):
             if not r["traversed"] and r["first_body_contact"]:
                 bodies[r["first_body_contact"]] = bodies.get(r["first_body_contact"], 0) + 1
         summary.append({"height_m": h, "speed_mps": v, "controller": c, "runs": len(rs),
+                        "walking_height_on_flat_m": flat[(h, v, c)],
                         "crossed_board": sum(bool(r["crossed_board"]) for r in rs),
                         "traversed": sum(r["traversed"] for r in rs),
                         "traversed_of_crossed": sum(r["traversed"] for r in rs if r["crossed_board"]),
@@ -145,12 +158,13 @@ def write_tables(out, report):
     o = report["offsets_m"]
     lines = [f"# terrain-scan: {report['terrain']}, course shifted by {o[0]:+.3f} ... {o[-1]:+.3f} m "
              f"({len(o)} offsets); profiles {', '.join(report['profiles']) or 'none (the paper setup)'}", "",
-             "| height [m] | speed [m/s] | controller | crossed the board | traversed the course | "
-             "failed runs' first body contact |", "|---|---|---|---|---|---|"]
+             "| height [m] | speed [m/s] | controller | walking height on flat ground [m] | crossed the board | "
+             "traversed the course | failed runs' first body contact |", "|---|---|---|---|---|---|---|"]
     for s in report["cells"]:
         bodies = ", ".join(f"{b} {n}" for b, n in sorted(s["failed_first_body_contact"].items())) or "-"
+        z = "fell" if s["walking_height_on_flat_m"] is None else f"{s['walking_height_on_flat_m']:.3f}"
         lines.append(f"| {s['height_m']:.2f} | {s['speed_mps']:.2f} | {CONTROLLER_NAMES.get(s['controller'], s['controller'])} "
-                     f"| {s['crossed_board']}/{s['runs']} | {s['traversed']}/{s['runs']} | {bodies} |")
+                     f"| {z} | {s['crossed_board']}/{s['runs']} | {s['traversed']}/{s['runs']} | {bodies} |")
     (out / "terrain_scan.md").write_text("\n".join(lines) + "\n")
 
 

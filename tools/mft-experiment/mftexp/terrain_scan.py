@@ -186,9 +186,10 @@ def plot_scan(path, report):
                         f"{CONTROLLER_NAMES.get(s['controller'], s['controller'])}" for s in cells])
     ax.set_xlabel("course shifted by [cm] (the gait's phase at the board's edge)")
     ax.set_ylim(-0.7, len(cells) - 0.3)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.35 if len(cells) < 4 else -0.15), ncol=3, fontsize=8)
+    height_in = fig.get_size_inches()[1]
+    fig.legend(loc="lower center", ncol=3, fontsize=8, frameon=False)
     ax.set_title(f"blind walking over '{report['terrain']}': outcome per course offset", fontsize=10)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.35 / height_in, 1, 1))  # room for the legend's one line under the axis label
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path

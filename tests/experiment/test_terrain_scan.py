@@ -82,6 +82,27 @@ class TerrainScanTest(unittest.TestCase):
         self.assertGreater(sag, 0.008)
         self.assertLess(sag, 0.022)
 
+    def test_sigterm_stops_the_runs_in_flight(self):
+        out = Path(self.tmp.name) / "stopped"
+        p = subprocess.Popen([sys.executable, str(TOOL), "terrain-scan", "--bin-dir", str(BIN), "--out", str(out),
+                              "--no-snapshot"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        try:
+            for line in p.stderr:  # the first finished run's progress line: runs are in flight now
+                if "runs/min]" in line:
+                    break
+            p.terminate()
+            _, err = p.communicate(timeout=30)
+        finally:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+        self.assertEqual(p.returncode, 130, err)
+        self.assertIn("interrupted", err)
+        self.assertNotIn("Traceback", err)
+        left = subprocess.run(["pgrep", "-f", str(out)], capture_output=True, text=True).stdout.split()
+        self.assertEqual(left, [], "mft-closedloop runs of the stopped scan are still running")
+        self.assertFalse((out / "terrain_scan.md").exists())
+
     def test_bad_arguments_are_one_line(self):
         for args, expect in ((["--shift-step", "0"], "--shift-step"), (["--shift-step", "0.2"], "--shift-step"),
                              (["--speeds", "0.9"], "outside"), (["--terrain", "nowhere"], "does not exist"),

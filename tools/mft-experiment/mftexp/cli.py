@@ -432,7 +432,9 @@ def main(argv=None):
         return 2
     except (KeyboardInterrupt, Interrupted):
         REGISTRY.stop_all()
-        print("mft-experiment: interrupted; finished runs are kept (run the same command to resume)", file=sys.stderr)
+        print("mft-experiment: interrupted; " + ("no table written (a scan takes minutes: run it again)"
+                                                if args.command == "terrain-scan" else
+                                                "finished runs are kept (run the same command to resume)"), file=sys.stderr)
         return 130
     except UnicodeDecodeError as e:
         REGISTRY.stop_all()

@@ -15,11 +15,11 @@ import csv
 import re
 import shutil
 import time
-from concurrent.futures import ThreadPoolExecutor
+import threading
 from pathlib import Path
 
-from .common import (CONTROLLER_NAMES, ExperimentError, Progress, pyplot, run_closedloop, write_report,
-                     write_yaml_scenario)
+from .common import (CONTROLLER_NAMES, ExperimentError, Progress, pyplot, run_closedloop, run_workers,
+                     write_report, write_yaml_scenario)
 from .terrain import course_profiles, course_segments, load_yaml
 
 CLEARANCE_M = 0.3  # "past" an obstacle: the base this far beyond its far edge, the whole robot over it
@@ -54,6 +54,29 @@ def scan_scenario(height, speed, controller, terrain, duration):
             "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": height, "v_cmd_mps": 0.0},
                          {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": height, "v_cmd_mps": 0.0},
                          {"at_s": 2.0, "mode": "walk", "z_cmd_m": height, "v_cmd_mps": speed}]}
+
+
+def run_all(task, items, workers):
+    """task(item) for every item on `workers` threads, results in the items' order; Ctrl-C stops the runs in flight
+    (run_workers) and the first error ends the scan."""
+    results = [None] * len(items)
+    errors = []
+    lock = threading.Lock()
+    next_index = [0]
+
+    def worker(_):
+        while not errors:
+            with lock:
+                i = next_index[0]
+                next_index[0] += 1
+            if i >= len(items):
+                return
+            try:
+                results[i] = task(items[i])
+            except Exception as e:  # reported once by run_workers, as one line
+                errors.append(e)
+    run_workers(worker, min(workers, len(items)), errors, "interrupted: stopping the runs in flight")
+    return results
 
 
 def judge(run, segs, offset):
@@ -102,12 +125,13 @@ def cmd_terrain_scan(args):
         sim, wall = run_closedloop(scen, args.bin_dir, configs[o], timeout_s=600.0, profiles=args.profile)
         crossed, traversed = judge(sim, segs, o)
         contact = sim.get("first_body_contact") or {}
+        board = [s for s in segs if s[0] == "board"]
         row = {"height_m": h, "speed_mps": v, "controller": c, "offset_m": o, "crossed_board": crossed,
                "traversed": traversed, "fell": sim["fell"], "fall_time_s": sim["fall_time_s"],
                "max_base_x_m": round(sim["max_base_x_m"], 4),
                "first_body_contact": contact.get("body"),
-               "contact_x_from_board_m": (None if contact.get("x_m") is None or not any(s[0] == "board" for s in segs)
-                                          else round(contact["x_m"] - ([s for s in segs if s[0] == "board"][0][1] + o), 4)),
+               "contact_x_from_board_m": (None if contact.get("x_m") is None or not board
+                                          else round(contact["x_m"] - (board[0][1] + o), 4)),
                "contact_time_s": contact.get("time_s")}
         left[0] -= 1
         progress.run_finished(wall, f"{h:.2f} m {v:.2f} m/s {c} offset {o:+.3f} m: "
@@ -123,10 +147,10 @@ def cmd_terrain_scan(args):
         write_yaml_scenario(scen, dict(scan_scenario(h, v, c, "flat", 8.0), name=f"terrain-scan-flat-{c}"))
         sim, _ = run_closedloop(scen, args.bin_dir, args.config_dir, timeout_s=120.0, profiles=args.profile)
         z = sim.get("mean_base_z_m")
-        return cell, None if sim["fell"] or z is None else round(z, 4)
-    with ThreadPoolExecutor(max_workers=args.workers) as pool:
-        flat = dict(pool.map(flat_height, cells))
-        rows = list(pool.map(one, jobs))
+        return None if sim["fell"] or z is None else round(z, 4)
+    flat = run_all(flat_height, cells, args.workers)
+    flat = dict(zip(cells, flat))
+    rows = run_all(one, jobs, args.workers)
     summary = []
     for h, v, c in cells:
         rs = [r for r in rows if (r["height_m"], r["speed_mps"], r["controller"]) == (h, v, c)]

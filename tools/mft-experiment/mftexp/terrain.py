@@ -80,15 +80,20 @@ def violation(rows, b, qr, qf):
     return max(a0 * qr + a1 * qf - bi for (a0, a1), bi in zip(rows, b))
 
 
+def walk_scenario(height, speed, controller, terrain, duration, name, tool="terrain"):
+    """Stand 1 s, step in place 1 s, then walk at `speed` and `height` over `terrain` (blind), Kalman estimator."""
+    return {"name": name, "description": f"mft-experiment {tool}: blind walking at {speed} m/s, {height} m over {terrain}, "
+                                         f"{controller}",
+            "duration_s": duration, "controller": controller, "estimator": "kalman", "terrain": terrain,
+            "initial_base_height_m": height, "fall": {"base_height_below_m": 0.25, "pitch_beyond_rad": 0.8},
+            "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": height, "v_cmd_mps": 0.0},
+                         {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": height, "v_cmd_mps": 0.0},
+                         {"at_s": 2.0, "mode": "walk", "z_cmd_m": height, "v_cmd_mps": speed}]}
+
+
 def scenario(args, controller, duration):
-    h, v = args.height, args.speed
-    return {"name": f"terrain-{args.terrain}-{controller}",
-            "description": f"mft-experiment: blind walking at {v} m/s, {h} m over {args.terrain}, {controller}",
-            "duration_s": duration, "controller": controller, "estimator": "kalman", "terrain": args.terrain,
-            "initial_base_height_m": h, "fall": {"base_height_below_m": 0.25, "pitch_beyond_rad": 0.8},
-            "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": h, "v_cmd_mps": 0.0},
-                         {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": h, "v_cmd_mps": 0.0},
-                         {"at_s": 2.0, "mode": "walk", "z_cmd_m": h, "v_cmd_mps": v}]}
+    return walk_scenario(args.height, args.speed, controller, args.terrain, duration,
+                         f"terrain-{args.terrain}-{controller}")
 
 
 def cmd_terrain(args):

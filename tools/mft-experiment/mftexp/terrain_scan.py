@@ -20,7 +20,7 @@ from pathlib import Path
 
 from .common import (CONTROLLER_NAMES, ExperimentError, Progress, pyplot, run_closedloop, run_workers,
                      write_report, write_yaml_scenario)
-from .terrain import course_profiles, course_segments, load_yaml
+from .terrain import course_profiles, course_segments, load_yaml, walk_scenario
 
 CLEARANCE_M = 0.3  # "past" an obstacle: the base this far beyond its far edge, the whole robot over it
 
@@ -46,16 +46,6 @@ def shifted_config(src, dest, terrain, offset):
     return dest
 
 
-def scan_scenario(height, speed, controller, terrain, duration):
-    return {"name": f"terrain-scan-{controller}", "duration_s": duration, "controller": controller,
-            "description": f"mft-experiment terrain-scan: blind walking at {speed} m/s, {height} m over {terrain}",
-            "estimator": "kalman", "terrain": terrain, "initial_base_height_m": height,
-            "fall": {"base_height_below_m": 0.25, "pitch_beyond_rad": 0.8},
-            "commands": [{"at_s": 0.0, "mode": "stand", "z_cmd_m": height, "v_cmd_mps": 0.0},
-                         {"at_s": 1.0, "mode": "step_in_place", "z_cmd_m": height, "v_cmd_mps": 0.0},
-                         {"at_s": 2.0, "mode": "walk", "z_cmd_m": height, "v_cmd_mps": speed}]}
-
-
 def run_all(task, items, workers):
     """task(item) for every item on `workers` threads, results in the items' order; Ctrl-C stops the runs in flight
     (run_workers) and the first error ends the scan."""
@@ -79,14 +69,12 @@ def run_all(task, items, workers):
     return results
 
 
-def judge(run, segs, offset):
-    """crossed_board (None without a board), traversed, from the run's summary and the shifted course."""
-    boards = [s for s in segs if s[0] == "board"]
-    obstacles = [s for s in segs if s[0] != "flat"]
+def judge(run, board_end, course_end, offset):
+    """(crossed_board, traversed) from the run's summary on the course shifted by `offset`: the base `CLEARANCE_M`
+    past the board's far edge (None without a board), and no fall with the base as far past the last obstacle."""
     x = run["max_base_x_m"]
-    crossed = None if not boards else x >= boards[0][2] + offset + CLEARANCE_M
-    traversed = (not run["fell"]) and x >= obstacles[-1][2] + offset + CLEARANCE_M
-    return crossed, traversed
+    crossed = None if board_end is None else x >= board_end + offset + CLEARANCE_M
+    return crossed, (not run["fell"]) and x >= course_end + offset + CLEARANCE_M
 
 
 def cmd_terrain_scan(args):
@@ -94,8 +82,12 @@ def cmd_terrain_scan(args):
     if not tfile.is_file():
         raise ExperimentError(f"terrain file {tfile} does not exist")
     segs = course_segments(load_yaml(tfile))
-    if not [s for s in segs if s[0] != "flat"]:
+    obstacles = [s for s in segs if s[0] != "flat"]
+    if not obstacles:
         raise ExperimentError(f"{tfile} has no board, slope or rough segment")
+    boards = [s for s in segs if s[0] == "board"]
+    board_start, board_end = (boards[0][1], boards[0][2]) if boards else (None, None)
+    course_end = obstacles[-1][2]  # the last obstacle's far edge, unshifted
     if not 0 < args.shift_step <= args.shift_span:
         raise ExperimentError("need 0 < --shift-step <= --shift-span")
     if args.shift_span / args.shift_step > 200:
@@ -103,17 +95,16 @@ def cmd_terrain_scan(args):
     args.profile = course_profiles(args)
     out = Path(args.out)
     shifts = offsets(args.shift_span, args.shift_step)
-    course_end = [s for s in segs if s[0] != "flat"][-1][2] + CLEARANCE_M
     cells = [(h, v, c) for h in args.heights for v in args.speeds for c in args.controllers]
     t0 = time.monotonic()
     configs = {o: shifted_config(Path(args.config_dir), out / "config-shifts" / f"shift{o:+.3f}", args.terrain, o)
                for o in shifts}
     jobs = []
     for h, v, c in cells:
-        duration = args.duration or min(300.0, round(2.0 + (course_end + max(shifts)) / (0.5 * v) + 3.0, 1))
+        duration = args.duration or min(300.0, round(2.0 + (course_end + CLEARANCE_M + max(shifts)) / (0.5 * v) + 3.0, 1))
         scen = out / "scenarios" / f"h{h:.3f}-v{v:.3f}-{c}.yaml"
         scen.parent.mkdir(parents=True, exist_ok=True)
-        write_yaml_scenario(scen, scan_scenario(h, v, c, args.terrain, duration))
+        write_yaml_scenario(scen, walk_scenario(h, v, c, args.terrain, duration, f"terrain-scan-{c}", "terrain-scan"))
         jobs += [(h, v, c, o, scen) for o in shifts]
     progress = Progress(args.workers, quiet=args.quiet)
     progress.note(f"{len(jobs)} runs: {len(cells)} cells x {len(shifts)} course offsets, {args.workers} at a time, "
@@ -123,33 +114,32 @@ def cmd_terrain_scan(args):
     def one(job):
         h, v, c, o, scen = job
         sim, wall = run_closedloop(scen, args.bin_dir, configs[o], timeout_s=600.0, profiles=args.profile)
-        crossed, traversed = judge(sim, segs, o)
+        crossed, traversed = judge(sim, board_end, course_end, o)
         contact = sim.get("first_body_contact") or {}
-        board = [s for s in segs if s[0] == "board"]
         row = {"height_m": h, "speed_mps": v, "controller": c, "offset_m": o, "crossed_board": crossed,
                "traversed": traversed, "fell": sim["fell"], "fall_time_s": sim["fall_time_s"],
                "max_base_x_m": round(sim["max_base_x_m"], 4),
                "first_body_contact": contact.get("body"),
-               "contact_x_from_board_m": (None if contact.get("x_m") is None or not board
-                                          else round(contact["x_m"] - (board[0][1] + o), 4)),
+               "contact_x_from_board_m": (None if contact.get("x_m") is None or board_start is None
+                                          else round(contact["x_m"] - (board_start + o), 4)),
                "contact_time_s": contact.get("time_s")}
         left[0] -= 1
         progress.run_finished(wall, f"{h:.2f} m {v:.2f} m/s {c} offset {o:+.3f} m: "
                                     f"{'traversed' if traversed else 'crossed the board' if crossed else 'failed'}",
                               left[0])
         return row
+
     def flat_height(cell):
         """The base's mean height walking on flat ground (2-8 s), the cell's setup otherwise: what shapes the legs
         when they reach the board (with the paper's contact-force weight it sits below the command,
         docs/profiles.md)."""
         h, v, c = cell
         scen = out / "scenarios" / f"flat-h{h:.3f}-v{v:.3f}-{c}.yaml"
-        write_yaml_scenario(scen, dict(scan_scenario(h, v, c, "flat", 8.0), name=f"terrain-scan-flat-{c}"))
+        write_yaml_scenario(scen, walk_scenario(h, v, c, "flat", 8.0, f"terrain-scan-flat-{c}", "terrain-scan"))
         sim, _ = run_closedloop(scen, args.bin_dir, args.config_dir, timeout_s=120.0, profiles=args.profile)
         z = sim.get("mean_base_z_m")
         return None if sim["fell"] or z is None else round(z, 4)
-    flat = run_all(flat_height, cells, args.workers)
-    flat = dict(zip(cells, flat))
+    flat = dict(zip(cells, run_all(flat_height, cells, args.workers)))
     rows = run_all(one, jobs, args.workers)
     summary = []
     for h, v, c in cells:

@@ -349,10 +349,10 @@ def main(argv=None):
                         "--stack unpinned; none: no pinning")
         sp.add_argument("--chain-transport", choices=["shm", "dds"],
                         help="how the chain's topics go from service to service: shm (a shared-memory segment per "
-                        "stack, a hop about one thread wake-up; DDS still carries every topic to every other reader) "
-                        "or dds (DDS alone). Default: shm in lockstep, dds in realtime (where shm is an opt-in "
-                        "measured for latency; a foreign DDS writer of a chain topic, such as mft-inject, then does not "
-                        "reach the chain). --secure and --stack always use DDS (docs/loop-benchmark.md)")
+                        "stack, a hop about one thread wake-up; DDS still carries every topic to every reader outside "
+                        "the chain, and the chain still hears DDS writers from outside the stack, such as mft-inject) "
+                        "or dds (DDS alone). Default: shm. --secure and --stack always use DDS "
+                        "(docs/loop-benchmark.md)")
         sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
                         "identities in DIR (scripts/make-security.sh; docs/security.md)")
         sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "

@@ -72,10 +72,10 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
 
 
 def chain_shm_name(args, multi_host):
-    """The shared-memory segment of this stack's chain channel, or None: --chain-transport, by default shm in
-    lockstep and dds in realtime (an opt-in there); never with --secure (it would bypass access control) or --stack
-    (several hosts), nor on a machine without a writable /dev/shm (some containers)."""
-    transport = getattr(args, "chain_transport", None) or ("shm" if args.mode == "lockstep" else "dds")
+    """The shared-memory segment of this stack's chain channel, or None: --chain-transport, by default shm in both
+    modes; never with --secure (it would bypass access control) or --stack (several hosts), nor on a machine without
+    a writable /dev/shm (some containers)."""
+    transport = getattr(args, "chain_transport", None) or "shm"
     if transport != "shm" or multi_host or getattr(args, "secure", None) or not os.access("/dev/shm", os.W_OK):
         return None
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"

@@ -86,6 +86,38 @@ void ChainSlotWriter::write(const unsigned char* bytes, std::size_t size) {
   if (slot_.sleepers.load(std::memory_order_seq_cst) > 0) futexWakeAll(&slot_.head);
 }
 
+namespace {
+std::uint64_t idWord(const ChainChannel::EndpointId& id, int half) {
+  std::uint64_t w = 0;
+  std::memcpy(&w, id.data() + 8 * half, 8);
+  return w;
+}
+}  // namespace
+
+int addEndpoint(ChainChannel::EndpointList& list, const ChainChannel::EndpointId& id) {
+  const int place = static_cast<int>(list.added.fetch_add(1) % ChainChannel::kEndpoints);
+  list.id[place][0].store(idWord(id, 0));
+  list.id[place][1].store(idWord(id, 1));
+  list.version.fetch_add(1);
+  return place;
+}
+
+void removeEndpoint(ChainChannel::EndpointList& list, int place, const ChainChannel::EndpointId& id) {
+  if (place < 0 || place >= ChainChannel::kEndpoints) return;
+  if (list.id[place][0].load() != idWord(id, 0) || list.id[place][1].load() != idWord(id, 1)) return;
+  list.id[place][0].store(0);
+  list.id[place][1].store(0);
+  list.version.fetch_add(1);
+}
+
+bool hasEndpoint(const ChainChannel::EndpointList& list, const ChainChannel::EndpointId& id) {
+  const std::uint64_t w0 = idWord(id, 0), w1 = idWord(id, 1);
+  if (w0 == 0 && w1 == 0) return false;
+  for (const auto& entry : list.id)
+    if (entry[0].load(std::memory_order_acquire) == w0 && entry[1].load(std::memory_order_acquire) == w1) return true;
+  return false;
+}
+
 long copyChainSample(const ChainChannel::Slot& slot, std::uint32_t n, unsigned char* buffer) {
   const ChainChannel::Entry& entry = slot.ring[n % ChainChannel::kRing];
   if (entry.seq.load(std::memory_order_acquire) != 2 * n + 2) return -1;
@@ -126,6 +158,7 @@ ChainSlotReader::Take ChainSlotReader::take(std::uint32_t head) {
 }
 
 bool ChainSlotReader::poll() {
+  if (thread_.joinable()) return false;
   for (;;) {
     const Take t = take(slot_.head.load(std::memory_order_acquire));
     if (t != Take::Torn) return t == Take::Delivered;
@@ -140,6 +173,7 @@ void ChainSlotReader::sleepWhile(std::uint32_t head, const struct timespec* time
 }
 
 bool ChainSlotReader::awaitNew(std::chrono::nanoseconds timeout) {
+  if (thread_.joinable()) return false;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     const std::uint32_t head = slot_.head.load(std::memory_order_acquire);

@@ -1,5 +1,5 @@
 #pragma once
-// The lockstep chain's shared-memory channel (docs/loop-benchmark.md, "The shared-memory chain channel"): the topics
+// The chain's shared-memory channel (docs/loop-benchmark.md, "The shared-memory chain channel"): the topics
 // the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics go
 // between the processes of one stack (the four chain services and the recorder) through a POSIX shared-memory
 // segment the supervisor names, instead of through the DDS stack. Each topic has one slot: a ring of the last
@@ -9,7 +9,13 @@
 //
 // The chain's readers take the newest sample (a stage writes tick k+1 only after the whole chain answered tick k);
 // the recorder takes every sample in order (ChainSlotArchive), kept within the ring by the simulator's recorder
-// window, and counts what the writer overwrote before it got there. One writer per slot. No DDS here.
+// window, and counts what the writer overwrote before it got there. One writer per slot.
+//
+// Each slot also lists the DDS endpoints of this stack on its topic, as opaque 16-byte ids (a GUID; no DDS here):
+// the stack's writer, and the DDS readers with which the chain's readers hear writers from outside the stack
+// (mft-inject, a foreign controller). The writer sends over DDS only while a reader not on that list is matched;
+// a chain reader drops what it hears over DDS from a writer on the list (it has the sample from the slot).
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -41,11 +47,20 @@ class ChainChannel {
     std::atomic<std::uint32_t> size;
     alignas(64) unsigned char data[kSlotBytes];
   };
+  static constexpr int kEndpoints = 8;  // per list; a restarted service takes the oldest entry
+  using EndpointId = std::array<unsigned char, 16>;
+  struct EndpointList {
+    std::atomic<std::uint32_t> added;    // entries ever added: the next one goes to added % kEndpoints
+    std::atomic<std::uint32_t> version;  // bumped after every change, so a reader of the list knows to look again
+    std::atomic<std::uint64_t> id[kEndpoints][2];
+  };
   struct Slot {
     alignas(64) std::atomic<std::uint32_t> head;  // samples written so far; the futex word
     std::atomic<std::uint32_t> sleepers;          // readers inside FUTEX_WAIT (the writer wakes only then)
     std::atomic<std::uint32_t> readers;           // attached readers and writers: the channel's "matched"
     std::atomic<std::uint32_t> writers;
+    EndpointList stack_writers;     // the stack's DDS writers of this topic
+    EndpointList chain_listeners;   // the chain readers' DDS readers, which listen for writers outside the stack
     Entry ring[kRing];
   };
 
@@ -68,6 +83,12 @@ class ChainChannel {
   Slot* slots_ = nullptr;
 };
 
+// Puts `id` on `list`; its place, for removeEndpoint. An all-zero id is no endpoint.
+int addEndpoint(ChainChannel::EndpointList& list, const ChainChannel::EndpointId& id);
+// Takes the entry at `place` off `list` if it still holds `id` (a newer endpoint may have taken the place).
+void removeEndpoint(ChainChannel::EndpointList& list, int place, const ChainChannel::EndpointId& id);
+bool hasEndpoint(const ChainChannel::EndpointList& list, const ChainChannel::EndpointId& id);
+
 // Copies sample `n` of `slot` into `buffer` if it is whole and still there; its size, or -1 (overwritten or
 // being written).
 long copyChainSample(const ChainChannel::Slot& slot, std::uint32_t n, unsigned char* buffer);
@@ -82,6 +103,7 @@ class ChainSlotWriter {
 
   void write(const unsigned char* bytes, std::size_t size);
   int readers() const { return static_cast<int>(slot_.readers.load()); }
+  ChainChannel::Slot& slot() { return slot_; }
 
  private:
   ChainChannel::Slot& slot_;
@@ -101,12 +123,14 @@ class ChainSlotReader {
   ChainSlotReader(const ChainSlotReader&) = delete;
   ChainSlotReader& operator=(const ChainSlotReader&) = delete;
 
-  // Polled: delivers the newest sample if it is new (on the caller's thread); whether it did.
+  // Polled: delivers the newest sample if it is new (on the caller's thread); whether it did. A Woken reader's own
+  // thread takes every sample: false, at once (two threads taking from one reader would share its buffer).
   bool poll();
-  // Polled: sleeps until a new sample is in the slot or `timeout` passed, then poll().
+  // Polled: sleeps until a new sample is in the slot or `timeout` passed, then poll(). Woken: false, at once.
   bool awaitNew(std::chrono::nanoseconds timeout);
 
   int writers() const { return static_cast<int>(slot_.writers.load()); }
+  ChainChannel::Slot& slot() { return slot_; }
   std::uint64_t torn() const { return torn_.load(); }  // copies retried because the writer overwrote them
 
  private:

@@ -68,8 +68,8 @@ class DdsParticipant {
   eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
   eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
   int domainId() const { return domain_id_; }
-  // Lockstep chain services only: the shared-memory channel their chain topics also travel by
-  // (chain_channel.hpp). TopicWriter/TopicReader with the lockstep profiles use it when it is open.
+  // Chain services only: the shared-memory channel their chain topics travel by (chain_channel.hpp).
+  // TopicWriter/TopicReader with the chain's profiles (lockstep or realtime) use it when it is open.
   void openChainChannel(const std::string& name) { chain_channel_ = std::make_unique<ChainChannel>(name); }
   ChainChannel* chainChannel() const { return chain_channel_.get(); }
 

@@ -97,18 +97,18 @@ class ChainPlacementTest(unittest.TestCase):
 
 
 class ChainTransportTest(unittest.TestCase):
-    """--chain-transport: the shared-memory chain channel by default in lockstep, on request in realtime, never
-    with --secure or on several hosts."""
+    """--chain-transport: the shared-memory chain channel by default in both modes, DDS alone on request, never the
+    channel with --secure or on several hosts."""
 
-    def test_lockstep_by_default_realtime_on_request_never_secure_or_multi_host(self):
+    def test_shm_by_default_dds_on_request_never_secure_or_multi_host(self):
         def args(**kw):
             return argparse.Namespace(**dict(dict(mode="lockstep", chain_transport="shm", secure=None, domain=7), **kw))
         name = chain_shm_name(args(), False)
         self.assertRegex(name, r"^/mft-chain-d7-\d+-\d+$")
         self.assertNotEqual(name, chain_shm_name(args(domain=8), False))
-        self.assertIsNone(chain_shm_name(args(mode="realtime", chain_transport=None), False))  # realtime: DDS by default
-        self.assertRegex(chain_shm_name(args(mode="realtime"), False), r"^/mft-chain-d7-")  # unless asked
-        self.assertRegex(chain_shm_name(args(chain_transport=None), False), r"^/mft-chain-d7-")  # lockstep: shm
+        self.assertRegex(chain_shm_name(args(mode="realtime", chain_transport=None), False), r"^/mft-chain-d7-")
+        self.assertRegex(chain_shm_name(args(chain_transport=None), False), r"^/mft-chain-d7-")
+        self.assertIsNone(chain_shm_name(args(mode="realtime", chain_transport="dds"), False))
         self.assertIsNone(chain_shm_name(args(chain_transport="dds"), False))
         self.assertIsNone(chain_shm_name(args(secure="/some/dir"), False))
         self.assertIsNone(chain_shm_name(args(), True))  # --stack: several hosts

@@ -107,9 +107,12 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
            eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK;
   }
   // Matched readers: over DDS, or on the chain channel plus those outside the chain over DDS.
-  int matched() const { return shm_ ? shm_->readers() + outside_readers_.load() : matched_.load(); }
+  int matched() const { return shm_ ? shm_->readers() + outsideReaders() : matched_.load(); }
   // On the chain channel: the DDS readers this writer sends to (not the chain's own listeners).
-  int outsideReaders() const { return outside_readers_.load(); }
+  int outsideReaders() const {
+    if (shm_ && shm_->slot().chain_listeners.version.load(std::memory_order_acquire) != listeners_seen_) countOutsideReaders();
+    return outside_readers_.load();
+  }
   int ddsMatched() const { return matched_.load(); }  // every matched DDS reader, the chain's listeners included
   bool viaChainChannel() const { return shm_ != nullptr; }
   std::uint64_t offeredDeadlineMisses() const { return offered_deadline_misses_.load(); }
@@ -138,7 +141,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   std::atomic<std::uint64_t> offered_deadline_misses_{0};
   // The matched DDS readers the chain's listeners are not: recounted when a reader matches or goes and when the
   // slot's list of listeners changed (a listener may match before it is on the list).
-  void countOutsideReaders() {
+  void countOutsideReaders() const {
     std::lock_guard<std::mutex> lock(matched_mutex_);
     const ChainChannel::EndpointList& listeners = shm_->slot().chain_listeners;
     listeners_seen_ = listeners.version.load(std::memory_order_acquire);
@@ -151,10 +154,10 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   std::unique_ptr<ChainSlotWriter> shm_;
   ChainChannel::EndpointId id_{};
   int id_place_ = -1;
-  std::mutex matched_mutex_;
+  mutable std::mutex matched_mutex_;
   std::vector<ChainChannel::EndpointId> matched_readers_;  // reserved: a match does not allocate below 64 readers
-  std::atomic<std::uint32_t> listeners_seen_{~0u};
-  std::atomic<int> outside_readers_{0};
+  mutable std::atomic<std::uint32_t> listeners_seen_{~0u};
+  mutable std::atomic<int> outside_readers_{0};
 };
 
 template <class Msg, class PubSubType>

@@ -265,7 +265,7 @@ class Matrix:
             parts = []
             if svc == "mft-sim" and kind.startswith("stop"):
                 misses = sum(v or 0 for v in row.data["reader_deadline_misses"].values())
-                row.detection = (f"DDS deadline at the chain's readers ({misses} misses, 3 ms); on resume the sim's "
+                row.detection = (f"deadline at the chain's readers ({misses} misses, 3 ms); on resume the sim's "
                                  f"watchdog sees the gap and damps")
                 if longest and longest[2] >= 5:
                     parts.append(f"damping {longest[2]:.0f} ms after resuming")
@@ -290,7 +290,7 @@ class Matrix:
                     row.detection = "none needed (the stack does not wait for the recorder)"
                 else:
                     misses = sum(v or 0 for v in row.data["reader_deadline_misses"].values())
-                    row.detection = f"DDS deadline: {misses} reader deadline misses (3 ms)"
+                    row.detection = f"deadline: {misses} reader deadline misses (3 ms)"
             if svc == "mft-sim" and kind != "stop50ms":
                 ncl = sum(1 for n in ("mft-estimator", "mft-planner", "mft-wbc") if sums[n].get("new_clocks"))
                 if kind in ("kill9", "restart"):

@@ -7,7 +7,8 @@
 // that is also the futex the chain's readers sleep on. A write is a copy and, when a reader sleeps, one
 // FUTEX_WAKE: a hop costs about one thread wake-up instead of a UDP send, a receive and a listener dispatch.
 //
-// The chain's readers take the newest sample (a stage writes tick k+1 only after the whole chain answered tick k);
+// The chain's readers take the newest sample (in lockstep a stage writes tick k+1 only after the whole chain answered
+// tick k; in realtime, as a DDS reader of history depth 1, a reader that fell behind skips to the newest);
 // the recorder takes every sample in order (ChainSlotArchive), kept within the ring by the simulator's recorder
 // window, and counts what the writer overwrote before it got there. One writer per slot.
 //

@@ -39,7 +39,6 @@ struct HasTickField : std::false_type {};
 template <class M>
 struct HasTickField<M, std::void_t<decltype(std::declval<const M&>().tick())>> : std::true_type {};
 
-// A sample's CDR bytes from the chain channel into `msg`, through a payload reserved once (no allocation).
 // A DDS endpoint's GUID as the chain channel lists it.
 inline ChainChannel::EndpointId endpointId(const eprosima::fastrtps::rtps::InstanceHandle_t& handle) {
   ChainChannel::EndpointId id{};
@@ -51,6 +50,7 @@ inline ChainChannel::EndpointId endpointId(const eprosima::fastrtps::rtps::GUID_
   return endpointId(eprosima::fastrtps::rtps::InstanceHandle_t(guid));
 }
 
+// A sample's CDR bytes from the chain channel into `msg`, through a payload reserved once (no allocation).
 template <class Msg, class PubSubType>
 bool fromChainBytes(PubSubType& type, eprosima::fastrtps::rtps::SerializedPayload_t& payload, const unsigned char* bytes,
                     std::size_t size, Msg* msg) {

@@ -239,3 +239,34 @@ TEST(ChainChannel, ArchiveTakesEverySampleInOrderAndCountsWhatTheRingLost) {
   EXPECT_EQ(got.back(), pattern(n - 1, 64));
   EXPECT_EQ(archive.drain(keep), 0u);  // nothing new
 }
+
+// The slot's lists of DDS endpoints (the stack's writers, the chain's listeners): an id is found once added and
+// not after it was taken off; a restarted service's id takes the oldest place when the list is full, and taking
+// the old id off then leaves the new one alone; the all-zero id is never an endpoint; every change bumps the version.
+TEST(ChainChannel, EndpointListsFindWhatWasAddedAndRecycleTheOldestPlace) {
+  const Unlink segment{uniqueName("endpoints")};
+  ChainChannel channel(segment.name);
+  ChainChannel::EndpointList& list = channel.slot(4).stack_writers;
+  auto id = [](unsigned char n) {
+    ChainChannel::EndpointId e{};
+    e.fill(static_cast<unsigned char>(0x10 + n));
+    e[15] = n;
+    return e;
+  };
+  EXPECT_FALSE(hasEndpoint(list, ChainChannel::EndpointId{}));
+  const std::uint32_t v0 = list.version.load();
+  int places[ChainChannel::kEndpoints + 1];
+  for (int n = 0; n <= ChainChannel::kEndpoints; ++n) places[n] = addEndpoint(list, id(static_cast<unsigned char>(n)));
+  EXPECT_EQ(list.version.load(), v0 + ChainChannel::kEndpoints + 1);
+  EXPECT_EQ(places[ChainChannel::kEndpoints], places[0]);  // the list was full: the oldest place again
+  EXPECT_FALSE(hasEndpoint(list, id(0)));
+  for (int n = 1; n <= ChainChannel::kEndpoints; ++n) EXPECT_TRUE(hasEndpoint(list, id(static_cast<unsigned char>(n)))) << n;
+  removeEndpoint(list, places[0], id(0));  // the old id's place now holds the newest: left alone
+  EXPECT_TRUE(hasEndpoint(list, id(ChainChannel::kEndpoints)));
+  removeEndpoint(list, places[3], id(3));
+  EXPECT_FALSE(hasEndpoint(list, id(3)));
+  EXPECT_EQ(list.version.load(), v0 + ChainChannel::kEndpoints + 2);
+  EXPECT_FALSE(hasEndpoint(channel.slot(4).chain_listeners, id(4)));  // the two lists are apart
+  ChainChannel other_process(segment.name);  // what one process added, another mapping sees
+  EXPECT_TRUE(hasEndpoint(other_process.slot(4).stack_writers, id(5)));
+}

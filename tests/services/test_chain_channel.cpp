@@ -1,7 +1,8 @@
-// The lockstep chain's shared-memory channel (services/runtime/chain_channel.hpp): every sample arrives once,
-// whole and in order through a ping-pong as the chain runs it, in one process and across two; a late reader
-// does not get an earlier stack's sample; a copy torn by a concurrent write is never delivered; bad names are
-// refused with the reason; the recorder's archive takes every sample in order and counts what the ring lost.
+// The chain's shared-memory channel (services/runtime/chain_channel.hpp): every sample arrives once, whole and
+// in order through a ping-pong as the chain runs it, in one process and across two; a late reader does not get
+// an earlier stack's sample; a copy torn by a concurrent write is never delivered; bad names are refused with the
+// reason; the recorder's archive takes every sample in order and counts what the ring lost; the slot's lists of
+// DDS endpoints find what was added and recycle the oldest place.
 #include <gtest/gtest.h>
 #include <sys/mman.h>
 #include <sys/wait.h>

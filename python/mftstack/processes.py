@@ -168,6 +168,10 @@ class Service:
             return json.loads(self.summary_path.read_text())
         except (OSError, ValueError):
             pass
+        if self._reader is not None and self.proc is not None and self.proc.poll() is not None:
+            # The service has exited: its last output line (a SUMMARY it could not write to a file) may still be in
+            # the pipe. Seen once under load: a full disk's summary read as missing.
+            self._reader.join(timeout=2.0)
         try:
             return json.loads(self.stdout_summary) if self.stdout_summary else None
         except ValueError:

@@ -50,6 +50,19 @@ inline ChainChannel::EndpointId endpointId(const eprosima::fastrtps::rtps::GUID_
   return endpointId(eprosima::fastrtps::rtps::InstanceHandle_t(guid));
 }
 
+// A match event of a DDS endpoint: the peer `handle` put on or taken off `matched` (the ids of the matched peers).
+inline void followMatch(std::vector<ChainChannel::EndpointId>& matched,
+                        const eprosima::fastrtps::rtps::InstanceHandle_t& handle, int count_change) {
+  const ChainChannel::EndpointId id = endpointId(handle);
+  const auto it = std::find(matched.begin(), matched.end(), id);
+  if (count_change > 0 && it == matched.end()) matched.push_back(id);
+  if (count_change < 0 && it != matched.end()) matched.erase(it);
+}
+// How many of `ids` are not on the slot's `list`.
+inline int countNotOn(const std::vector<ChainChannel::EndpointId>& ids, const ChainChannel::EndpointList& list) {
+  return static_cast<int>(std::count_if(ids.begin(), ids.end(), [&](const auto& id) { return !hasEndpoint(list, id); }));
+}
+
 // A sample's CDR bytes from the chain channel into `msg`, through a payload reserved once (no allocation).
 template <class Msg, class PubSubType>
 bool fromChainBytes(PubSubType& type, eprosima::fastrtps::rtps::SerializedPayload_t& payload, const unsigned char* bytes,
@@ -94,8 +107,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
       payload_.pos = 0;
       if (!type_.serialize(const_cast<Msg*>(&msg), &payload_)) return false;
       shm_->write(payload_.data, payload_.length);
-      if (shm_->slot().chain_listeners.version.load(std::memory_order_acquire) != listeners_seen_) countOutsideReaders();
-      if (outside_readers_.load() == 0) return true;  // best effort, volatile: such a DDS write would deliver nothing
+      if (outsideReaders() == 0) return true;  // best effort, volatile: such a DDS write would deliver nothing
     }
     return writer_->write(const_cast<Msg*>(&msg));
   }
@@ -109,6 +121,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
   // Matched readers: over DDS, or on the chain channel plus those outside the chain over DDS.
   int matched() const { return shm_ ? shm_->readers() + outsideReaders() : matched_.load(); }
   // On the chain channel: the DDS readers this writer sends to (not the chain's own listeners).
+  // Recounted only when the slot's list of listeners changed since (one atomic load otherwise: write() asks each time).
   int outsideReaders() const {
     if (shm_ && shm_->slot().chain_listeners.version.load(std::memory_order_acquire) != listeners_seen_) countOutsideReaders();
     return outside_readers_.load();
@@ -122,10 +135,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
     matched_ = s.current_count;
     {
       std::lock_guard<std::mutex> lock(matched_mutex_);  // the DDS thread's; write() takes it only after a change
-      const ChainChannel::EndpointId id = endpointId(s.last_subscription_handle);
-      const auto it = std::find(matched_readers_.begin(), matched_readers_.end(), id);
-      if (s.current_count_change > 0 && it == matched_readers_.end()) matched_readers_.push_back(id);
-      if (s.current_count_change < 0 && it != matched_readers_.end()) matched_readers_.erase(it);
+      followMatch(matched_readers_, s.last_subscription_handle, s.current_count_change);
     }
     if (shm_) countOutsideReaders();
   }
@@ -145,8 +155,7 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
     std::lock_guard<std::mutex> lock(matched_mutex_);
     const ChainChannel::EndpointList& listeners = shm_->slot().chain_listeners;
     listeners_seen_ = listeners.version.load(std::memory_order_acquire);
-    outside_readers_ = static_cast<int>(std::count_if(matched_readers_.begin(), matched_readers_.end(),
-                                                      [&](const auto& id) { return !hasEndpoint(listeners, id); }));
+    outside_readers_ = countNotOn(matched_readers_, listeners);
   }
 
   PubSubType type_;  // serializes into the chain channel's slot
@@ -257,10 +266,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
                                const eprosima::fastdds::dds::SubscriptionMatchedStatus& s) override {
     matched_ = s.current_count;
     std::lock_guard<std::mutex> lock(matched_mutex_);
-    const ChainChannel::EndpointId id = endpointId(s.last_publication_handle);
-    const auto it = std::find(matched_writers_.begin(), matched_writers_.end(), id);
-    if (s.current_count_change > 0 && it == matched_writers_.end()) matched_writers_.push_back(id);
-    if (s.current_count_change < 0 && it != matched_writers_.end()) matched_writers_.erase(it);
+    followMatch(matched_writers_, s.last_publication_handle, s.current_count_change);
   }
   void on_requested_deadline_missed(eprosima::fastdds::dds::DataReader*,
                                     const eprosima::fastdds::dds::RequestedDeadlineMissedStatus&) override {
@@ -312,8 +318,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   // Matched DDS writers that are not the stack's own (those come through the slot).
   int outsideWriters() const {
     std::lock_guard<std::mutex> lock(matched_mutex_);
-    return static_cast<int>(std::count_if(matched_writers_.begin(), matched_writers_.end(),
-                                          [&](const auto& id) { return !hasEndpoint(slot_->stack_writers, id); }));
+    return countNotOn(matched_writers_, slot_->stack_writers);
   }
 
   Callback on_sample_;

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::chain {
 namespace {

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "model/config/profiles.hpp"
-#include "model/config/strict_yaml.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/profiles.hpp"
+#include "common/strict_yaml.hpp"
+#include "common/tool_io.hpp"
 #include "planner/planner_config.hpp"
 
 namespace mft::chain {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "model/mft_criteria.hpp"
 #include "planner/planner_config.hpp"
 

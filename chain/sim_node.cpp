@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "chain/command_schedule.hpp"
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::chain {
 

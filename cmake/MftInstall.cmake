@@ -1,5 +1,5 @@
 # What `cmake --install` puts under a prefix and what `cpack -G DEB` packs (docs/library.md):
-#   lib/                       the algorithm libraries (static), exported as mft::config, mft::model, mft::qp,
+#   lib/                       the algorithm libraries (static), exported as mft::common, mft::model, mft::qp,
 #                              mft::wbc, mft::planner, mft::estimator, mft::sim
 #   lib/cmake/mft_wbc/         mft_wbcConfig.cmake (find_package(mft_wbc)), its version file and the targets
 #   include/mft/<library>/     their headers, in the layout the sources include them ("model/five_bar.hpp")
@@ -15,7 +15,7 @@ set(MFT_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/mft_wbc)
 
 # Library target -> exported name (mft::<name>) -> header folder of the source tree.
 set(MFT_EXPORTED_LIBRARIES
-  "mft_config|config|"          # headers in model/config, installed with the model's
+  "mft_common|common|common"   # common/: strict YAML, command line, JSON, tool I/O
   "mft_model|model|model"
   "mft_qp|qp|"                  # headers in wbc/qp, installed with the WBC's
   "mft_wbc|wbc|wbc"
@@ -59,7 +59,7 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/cmake/mft_wbcConfigVersio
 install(FILES ${PROJECT_BINARY_DIR}/cmake/mft_wbcConfig.cmake ${PROJECT_BINARY_DIR}/cmake/mft_wbcConfigVersion.cmake
         DESTINATION ${MFT_INSTALL_CMAKEDIR} COMPONENT development)
 
-# Data the installed executables find beside their bin/ (model/config/install_layout.hpp, python/mftstack/paths.py).
+# Data the installed executables find beside their bin/ (common/install_layout.hpp, python/mftstack/paths.py).
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${MFT_INSTALL_DATADIR}/config COMPONENT runtime)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/mft-export/mft-plot.py ${PROJECT_SOURCE_DIR}/tools/mft-export/mft-video.py
                  ${PROJECT_SOURCE_DIR}/tools/mft-space/mft_space_figure.py

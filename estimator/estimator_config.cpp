@@ -1,6 +1,6 @@
 #include "estimator/estimator_config.hpp"
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::estimator {
 namespace {

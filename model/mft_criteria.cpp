@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "model/config/enum_names.hpp"
+#include "common/enum_names.hpp"
 
 namespace mft::model {
 

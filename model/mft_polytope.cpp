@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <ostream>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::model {
 

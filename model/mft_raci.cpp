@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "model/config/enum_names.hpp"
+#include "common/enum_names.hpp"
 #include "model/mft_indices.hpp"
 
 namespace mft::model {

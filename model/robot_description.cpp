@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <cstring>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::model {
 namespace {

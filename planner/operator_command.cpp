@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::planner {
 

@@ -1,6 +1,6 @@
 #include "planner/planner_config.hpp"
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::planner {
 namespace {

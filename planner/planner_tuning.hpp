@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "model/config/live_tuning.hpp"
+#include "common/live_tuning.hpp"
 #include "planner/planner_config.hpp"
 
 namespace mft::planner {

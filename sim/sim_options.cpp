@@ -1,6 +1,6 @@
 #include "sim/sim_options.hpp"
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::sim {
 namespace {

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "sim/random.hpp"
 
 namespace mft::sim {

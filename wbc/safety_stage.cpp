@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "model/config/enum_names.hpp"
+#include "common/enum_names.hpp"
 
 namespace mft::wbc {
 

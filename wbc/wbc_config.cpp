@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::wbc {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "model/config/enum_names.hpp"
+#include "common/enum_names.hpp"
 
 namespace mft::wbc {
 namespace {

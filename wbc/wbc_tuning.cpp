@@ -1,6 +1,6 @@
 #include "wbc/wbc_tuning.hpp"
 
-#include "model/config/live_tuning.hpp"
+#include "common/live_tuning.hpp"
 
 namespace mft::wbc {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "model/robot_description.hpp"
-#include "model/config/live_tuning.hpp"
+#include "common/live_tuning.hpp"
 #include "wbc/wbc_config.hpp"
 
 namespace mft::wbc {

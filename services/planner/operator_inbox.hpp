@@ -9,7 +9,7 @@
 #include <string>
 
 #include "idl/msg_types.hpp"
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "planner/motion_planner.hpp"
 #include "services/runtime/command_verdict.hpp"
 

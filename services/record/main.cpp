@@ -8,8 +8,8 @@
 #include <memory>
 #include <thread>
 
-#include "model/config/strict_yaml.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/strict_yaml.hpp"
+#include "common/tool_io.hpp"
 #include "services/record/recording_files.hpp"
 #include "services/record/thread_priority.hpp"
 #include "services/record/topic_table.hpp"

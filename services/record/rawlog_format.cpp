@@ -13,7 +13,7 @@
 #include <tuple>
 #include <utility>
 
-#include "model/config/live_tuning.hpp"
+#include "common/live_tuning.hpp"
 
 namespace mft::rawlog {
 
@@ -277,7 +277,7 @@ std::vector<LabelLayout> makeLayouts() {
   // Appended after schema 1's first labels: a reader that predates it ignores the label (counted as unknown).
   l.push_back(rawDaq("config_change", Topic::ConfigChange,
                      "live tuning (mft-cmd --set): a request (applied 0) or a change in force from tick (applied 1); "
-                     "target 0 wbc.yaml, 1 planner.yaml; key = index in model/config/live_tuning.cpp tunableKeys() (-1: "
+                     "target 0 wbc.yaml, 1 planner.yaml; key = index in common/live_tuning.cpp tunableKeys() (-1: "
                      "not tunable); value_0/value_1 the value as loaded (count of them), requests hold none",
                      {scalar<ConfigChange>("seq", "-", MFT_MEMBER(seq)),
                       scalar<ConfigChange>("applied", "0/1", MFT_MEMBER(applied)),

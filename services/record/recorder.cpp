@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "services/record/gz_stream.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 namespace mft::rawlog {
 

@@ -16,7 +16,7 @@
 #include <tuple>
 #include <vector>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "services/record/rawlog_format.hpp"
 
 namespace mft::rawlog {

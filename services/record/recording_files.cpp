@@ -10,8 +10,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/config/profiles.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/profiles.hpp"
+#include "common/strict_yaml.hpp"
 #include "services/record/rawlog_format.hpp"
 #include "services/runtime/topic_names.hpp"
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "services/record/recorder.hpp"
 
 namespace mft::services {

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::services {
 

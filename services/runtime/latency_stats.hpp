@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::services {
 

@@ -4,8 +4,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/config/profiles.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/profiles.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::services {
 

@@ -23,7 +23,7 @@
 #include <thread>
 #include <vector>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "idl/msg_pubsub.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/topic_io.hpp"

@@ -1,11 +1,11 @@
 #pragma once
 // Process-level plumbing shared by the service mains: shutdown on SIGINT/SIGTERM, optional real-time
 // scheduling with a graceful fallback, the readiness line the supervisor waits for, and the strict
-// command-line parser (model/config/command_line.hpp: unknown options are errors, every service has --help).
+// command-line parser (common/command_line.hpp: unknown options are errors, every service has --help).
 #include <atomic>
 #include <string>
 
-#include "model/config/command_line.hpp"
+#include "common/command_line.hpp"
 
 namespace mft::services {
 

@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <fstream>
 
-#include "model/config/install_layout.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/install_layout.hpp"
+#include "common/strict_yaml.hpp"
 #include "chain/scenario_limits.hpp"
 
 namespace mft::services {

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "services/runtime/tick_gate.hpp"
 
 namespace mft::services {

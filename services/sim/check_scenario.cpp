@@ -6,9 +6,9 @@
 
 #include "chain/scenario_limits.hpp"
 #include "chain/sim_node.hpp"
-#include "model/config/install_layout.hpp"
-#include "model/config/profiles.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/install_layout.hpp"
+#include "common/profiles.hpp"
+#include "common/strict_yaml.hpp"
 #include "services/runtime/process.hpp"
 
 namespace mft::services {

@@ -9,8 +9,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "model/config/strict_yaml.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/strict_yaml.hpp"
+#include "common/tool_io.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/sim/check_scenario.hpp"
 #include "services/sim/sim_summary.hpp"

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::services {
 namespace {

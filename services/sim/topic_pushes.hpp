@@ -10,7 +10,7 @@
 
 #include "chain/sim_node.hpp"
 #include "idl/msg_pubsub.hpp"
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/service_context.hpp"
 #include "services/runtime/topic_io.hpp"

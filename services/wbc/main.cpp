@@ -11,8 +11,8 @@
 
 #include "chain/wbc_node.hpp"
 #include "idl/msg_pubsub.hpp"
-#include "model/config/strict_yaml.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/strict_yaml.hpp"
+#include "common/tool_io.hpp"
 #include "services/runtime/convert.hpp"
 #include "services/runtime/hop_trace.hpp"
 #include "services/runtime/live_tuning.hpp"

@@ -5,7 +5,7 @@
 #include <set>
 #include <string>
 
-#include "model/config/command_line.hpp"
+#include "common/command_line.hpp"
 #include "wbc/whole_body_controller.hpp"
 
 namespace mft::services {

@@ -1,6 +1,6 @@
 #include "services/wbc/wbc_summary.hpp"
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 namespace mft::services {
 

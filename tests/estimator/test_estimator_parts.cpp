@@ -7,7 +7,7 @@
 #include "estimator/estimator_config.hpp"
 #include "estimator/leg_kinematics.hpp"
 #include "estimator/pitch_filter.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "tests/support/config_test_support.hpp"
 
 using namespace mft;

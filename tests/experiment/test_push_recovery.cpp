@@ -5,7 +5,7 @@
 #include <cmath>
 #include <functional>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "chain/push_recovery.hpp"
 #include "chain/scenario.hpp"
 

@@ -56,7 +56,7 @@ class InstalledPrefix(unittest.TestCase):
         for name in ("mft_wbcConfig.cmake", "mft_wbcConfigVersion.cmake", "mft_wbcTargets.cmake"):
             self.assertTrue((self.cmake_dir / name).is_file(), name)
         for rel in ("include/mft/wbc/whole_body_controller.hpp", "include/mft/wbc/qp/qp_solver.hpp",
-                    "include/mft/model/config/strict_yaml.hpp", "include/mft/model/five_bar.hpp",
+                    "include/mft/common/strict_yaml.hpp", "include/mft/model/five_bar.hpp",
                     "include/mft/planner/motion_planner.hpp", "include/mft/estimator/state_estimator.hpp",
                     "include/mft/sim/simulator.hpp", "share/mft_wbc/config/robot.yaml",
                     "share/mft_wbc/config/scenarios/stand.yaml", "share/mft_wbc/python/mftstack/paths.py",
@@ -198,7 +198,7 @@ class InstalledPrefix(unittest.TestCase):
         include = self.prefix / "include" / "mft"
         headers = sorted(str(h.relative_to(include)) for h in include.rglob("*.hpp"))
         self.assertGreater(len(headers), 40)
-        components = ["config", "model", "qp", "wbc", "planner", "estimator", "sim"]
+        components = ["common", "model", "qp", "wbc", "planner", "estimator", "sim"]
         (src / "CMakeLists.txt").write_text(
             "cmake_minimum_required(VERSION 3.22)\nproject(all_headers LANGUAGES CXX)\n"
             f"find_package(mft_wbc REQUIRED COMPONENTS {' '.join(components)})\n"

@@ -11,7 +11,7 @@
 #include <regex>
 #include <sstream>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "model/mft_polytope.hpp"
 #include "tests/support/config_test_support.hpp"
 

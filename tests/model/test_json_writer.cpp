@@ -1,4 +1,4 @@
-// The one JSON writer of the tools' --json and the services' summaries (model/config/json_writer.hpp).
+// The one JSON writer of the tools' --json and the services' summaries (common/json_writer.hpp).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 using mft::config::JsonWriter;
 using mft::config::kRoundTrip;

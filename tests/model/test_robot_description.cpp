@@ -6,7 +6,7 @@
 #include <regex>
 #include <vector>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "model/robot_description.hpp"
 #include "tests/support/config_test_support.hpp"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "model/robot_description.hpp"
 #include "planner/operator_command.hpp"
 

@@ -1,7 +1,7 @@
 // config/planner.yaml: the shipped file loads with the paper's values; bad files fail naming file and key.
 #include <gtest/gtest.h>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "planner/planner_config.hpp"
 #include "tests/support/config_test_support.hpp"
 

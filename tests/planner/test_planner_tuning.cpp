@@ -2,8 +2,8 @@
 // gait timing is refused as structure, and every tunable planner key exists in the file.
 #include <gtest/gtest.h>
 
-#include "model/config/live_tuning.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/live_tuning.hpp"
+#include "common/strict_yaml.hpp"
 #include "tests/support/config_test_support.hpp"
 #include "planner/planner_tuning.hpp"
 

@@ -1,4 +1,4 @@
-// The profile overlay (model/config/profiles.hpp): strict, composable in order, applied by every loader, and
+// The profile overlay (common/profiles.hpp): strict, composable in order, applied by every loader, and
 // every shipped profile loads and states its reason.
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <sstream>
 #include <string>
 
-#include "model/config/profiles.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/profiles.hpp"
+#include "common/strict_yaml.hpp"
 #include "chain/scenario.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 

@@ -3,7 +3,7 @@
 
 #include <filesystem>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "chain/scenario.hpp"
 #include "tests/support/config_test_support.hpp"
 

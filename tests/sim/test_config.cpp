@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "sim_test_support.hpp"
 #include "tests/support/config_test_support.hpp"
 

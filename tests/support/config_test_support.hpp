@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::test {
 

@@ -1,7 +1,7 @@
 // config/wbc.yaml: strict loading, Table I defaults, clear errors.
 #include <gtest/gtest.h>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "tests/support/config_test_support.hpp"
 #include "wbc/whole_body_controller.hpp"
 #include "wbc_test_support.hpp"

@@ -4,8 +4,8 @@
 // file computes.
 #include <gtest/gtest.h>
 
-#include "model/config/live_tuning.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/live_tuning.hpp"
+#include "common/strict_yaml.hpp"
 #include "tests/support/config_test_support.hpp"
 #include "wbc/whole_body_controller.hpp"
 #include "wbc/wbc_tuning.hpp"

@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <sstream>
 
-#include "model/config/profiles.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/profiles.hpp"
+#include "common/tool_io.hpp"
 
 namespace mft::closedloop {
 namespace {

@@ -9,11 +9,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "chain/scenario_limits.hpp"
-#include "model/config/command_line.hpp"
+#include "common/command_line.hpp"
 #include "tools/closedloop/closed_loop.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 using namespace mft;
 

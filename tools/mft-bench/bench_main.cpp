@@ -4,7 +4,7 @@
 
 #include <cstring>
 #include <iostream>
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 static int toolMain(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {

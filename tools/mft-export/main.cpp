@@ -11,7 +11,7 @@
 #include <sstream>
 #include <vector>
 
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/runtime/process.hpp"
 #include "tools/mft-export/video.hpp"

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 #include "model/mft_polytope.hpp"
 #include "model/robot_description.hpp"
 #include "services/record/rawlog_reader.hpp"

@@ -33,7 +33,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;

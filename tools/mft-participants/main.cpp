@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "qp_commands.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 namespace {
 

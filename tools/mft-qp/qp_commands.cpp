@@ -14,7 +14,7 @@
 #include <sstream>
 #include <vector>
 
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 #include "wbc/qp/qp_io.hpp"
 #include "wbc/qp/qp_kkt.hpp"
 #include "wbc/qp/qp_solver.hpp"

@@ -26,7 +26,7 @@
 #include "services/runtime/topic_io.hpp"
 #include "wbc/wbc_config.hpp"
 #include "wbc/whole_body_controller.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 using namespace mft;
 using Clock = std::chrono::steady_clock;

@@ -1,6 +1,6 @@
 #pragma once
-// mft-space's JSON: the shared writer (model/config/json_writer.hpp), numbers at 10 significant digits.
-#include "model/config/json_writer.hpp"
+// mft-space's JSON: the shared writer (common/json_writer.hpp), numbers at 10 significant digits.
+#include "common/json_writer.hpp"
 
 namespace mft::tools {
 

@@ -13,10 +13,10 @@
 #include "cli_args.hpp"
 #include "figure.hpp"
 #include "json_writer.hpp"
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 #include "space_run.hpp"
 #include "stance_table.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 using namespace mft::model;
 using namespace mft::tools;

@@ -23,9 +23,9 @@
 #include <thread>
 #include <vector>
 
-#include "model/config/command_line.hpp"
-#include "model/config/json_writer.hpp"
-#include "model/config/tool_io.hpp"
+#include "common/command_line.hpp"
+#include "common/json_writer.hpp"
+#include "common/tool_io.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "model/config/profiles.hpp"
+#include "common/profiles.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::config {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "model/config/enum_names.hpp"
+#include "common/enum_names.hpp"
 
 namespace YAML {
 class Node;

@@ -1,4 +1,4 @@
-#include "model/config/command_line.hpp"
+#include "common/command_line.hpp"
 
 #include <cerrno>
 #include <cstdio>

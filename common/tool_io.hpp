@@ -5,8 +5,8 @@
 #include <functional>
 #include <string>
 
-#include "model/config/install_layout.hpp"  // the tools' data paths (configuration, scripts)
-#include "model/config/json_writer.hpp"        // every --json and summary
+#include "common/install_layout.hpp"  // the tools' data paths (configuration, scripts)
+#include "common/json_writer.hpp"        // every --json and summary
 
 namespace mft::config {
 

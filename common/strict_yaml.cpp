@@ -1,6 +1,6 @@
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
-#include "model/config/profiles.hpp"
+#include "common/profiles.hpp"
 
 #include <yaml-cpp/yaml.h>
 

@@ -1,4 +1,4 @@
-#include "model/config/json_writer.hpp"
+#include "common/json_writer.hpp"
 
 #include <cmath>
 #include <cstdio>

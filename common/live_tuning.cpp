@@ -1,4 +1,4 @@
-#include "model/config/live_tuning.hpp"
+#include "common/live_tuning.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::config {
 namespace {

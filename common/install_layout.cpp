@@ -1,4 +1,4 @@
-#include "model/config/install_layout.hpp"
+#include "common/install_layout.hpp"
 
 #include <filesystem>
 #include <system_error>

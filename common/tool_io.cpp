@@ -1,4 +1,4 @@
-#include "model/config/tool_io.hpp"
+#include "common/tool_io.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -7,7 +7,7 @@
 #include <new>
 #include <system_error>
 
-#include "model/config/strict_yaml.hpp"
+#include "common/strict_yaml.hpp"
 
 namespace mft::config {
 

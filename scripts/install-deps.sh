@@ -14,6 +14,7 @@ PACKAGES=(
   ffmpeg
   iproute2 nftables
   openssl
+  mkdocs mkdocs-material
 )
 
 missing=()

@@ -17,7 +17,7 @@ import shutil
 from dataclasses import asdict
 from pathlib import Path
 
-from .common import CONTROLLER_NAMES, ExperimentError, pyplot
+from .common import CONTROLLER_NAMES, ExperimentError, load_text, pyplot
 from .report import ratio
 from .sweep import Sweep, Variant
 
@@ -117,7 +117,6 @@ def cmd_ablation(args, setup):
         return job
 
     jobs = [stepping_job(v, c) for v in [variants[0]] + sens_variants for c in args.controllers]
-    from .cli import load_text
     load0 = sweep.announce(f"ablation into {args.out}: {len(variants)} variants x heights {args.heights} + "
                            f"{len(sens_variants)} values of {args.param} at {args.sensitivity_height} m, controllers "
                            f"{args.controllers}, search {args.search}, ")

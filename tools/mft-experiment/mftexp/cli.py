@@ -9,7 +9,7 @@ from pathlib import Path
 
 from . import push as _push, sweep as _sweep, video as _video
 from .common import (DEFAULT_BIN, DEFAULT_CONFIG, REPO, REGISTRY, ExperimentError, Interrupted, bounded, check_setup,
-                     log, fmt_duration, snapshot_binaries)
+                     load_text, log, fmt_duration, snapshot_binaries)
 
 HEIGHT_RANGE = (0.30, 0.46)
 DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the real multi-process stack, in lockstep.
@@ -163,13 +163,6 @@ def add_search(p, default):
     p.add_argument("--inprocess", action="store_true",
                    help="run mft-closedloop (the same libraries, configs and recovery verdict in one process, about "
                         "8x faster here) instead of the multi-process stack")
-
-
-def load_text():
-    try:
-        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
-    except OSError:
-        return "unknown"
 
 
 def make_setup(args):

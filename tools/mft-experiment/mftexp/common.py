@@ -339,6 +339,14 @@ def export_csv(bin_dir, rawlog, out_dir, labels):
         raise ExperimentError(f"mft-export failed on {rawlog}: {(p.stderr or p.stdout).strip()[-300:]}")
 
 
+def load_text():
+    """The load average (1, 5, 15 min) as text for the reports."""
+    try:
+        return " ".join(Path("/proc/loadavg").read_text().split()[:3])
+    except OSError:
+        return "unknown"
+
+
 def read_csv(path):
     """A numeric CSV of mft-export as {column: list of floats}."""
     import csv

@@ -23,7 +23,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .common import ExperimentError, Interrupted, Progress, REGISTRY, log, run_workers
+from .common import ExperimentError, Interrupted, Progress, REGISTRY, load_text, log, run_workers
 from . import push as pushmod
 from .executor import make_executor, run_task
 
@@ -629,7 +629,6 @@ class Sweep:
     # ------------------------------------------------------------------------------------------------- all
     def announce(self, what):
         """Logs the start of a study (`what`, then where its runs go and the load average); returns the load text."""
-        from .cli import load_text
         load0 = load_text()
         log(what + ("in process, " if self.args.inprocess else "") + self.executor.describe()
             + f"; load average {load0}")

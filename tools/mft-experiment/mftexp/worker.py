@@ -19,7 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .common import DEFAULT_BIN, ExperimentError, check_setup
-from .executor import BuildMismatch, RunFailed, build_identity, execute, files_sha256, identity_difference
+from .execution import BuildMismatch, RunFailed, build_identity, execute, files_sha256, identity_difference
 
 DOMAIN_WAIT_S = 600.0  # every domain of the pool held by other runs on this machine: wait this long at most
 

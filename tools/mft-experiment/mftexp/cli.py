@@ -175,12 +175,8 @@ def make_setup(args):
                                        max_pitch_rad=args.max_pitch, min_touchdowns=args.min_touchdowns))
 
 
-def build_parser():
-    p = Parser(prog="mft-experiment", description=DESCRIPTION,
-               formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,terrain-scan,ablation,worker}", parser_class=Parser)
-    sub.required = True
-
+def add_push_sweep_command(sub):
+    """push-sweep: Table II."""
     s = sub.add_parser("push-sweep", help="Table II: the largest recovered impulse per height and controller",
                        description=_sweep.__doc__ + "\n" + _push.__doc__,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -195,6 +191,9 @@ def build_parser():
                    help="do not keep the rawlogs of each cell's boundary runs")
     add_study_options(s, "experiment")
 
+
+def add_case_command(sub):
+    """case: one push, the paper's Fig. 6."""
     c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
                        description="One push at one height with both controllers (recorded), and the paper's "
                                    "Fig. 6 as a PNG: hip joint angles of both legs; base height, pitch and speed; "
@@ -207,6 +206,9 @@ def build_parser():
     add_common(c)
     _video.add_video_options(c)
 
+
+def add_terrain_command(sub):
+    """terrain: blind walking over the course, the paper's Fig. 8."""
     t = sub.add_parser("terrain", help="blind walking over the course with both controllers, the paper's Fig. 8",
                        description="Blind walking over config/terrain/<terrain>.yaml (3 cm board, 6 degree slope, "
                                    "about 2 cm rough ground) with both controllers, recorded. Success = the base "
@@ -226,6 +228,10 @@ def build_parser():
                         "the robot stalls on the slope; docs/experiments.md#terrain-fig-8)")
     add_common(t)
     _video.add_video_options(t)
+
+
+def add_terrain_scan_command(sub):
+    """terrain-scan: the course from many start offsets."""
     from . import terrain_scan as _scan
     ts = sub.add_parser("terrain-scan", help="the course from many start offsets: how often blind walking gets over it",
                         description=_scan.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -242,6 +248,10 @@ def build_parser():
     ts.add_argument("--paper-setup", action="store_true",
                     help="without the profile kv-0.145 that terrain's runs carry (see terrain --help)")
     add_common(ts)
+
+
+def add_ablation_command(sub):
+    """ablation: each departure alone, and a parameter's sensitivity."""
     from . import ablation as _abl
     a = sub.add_parser("ablation", help="each departure from the paper's setup alone; I_max against the slack weight",
                        description=_abl.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -261,6 +271,9 @@ def build_parser():
     a.add_argument("--no-sensitivity", dest="sensitivity", action="store_false", help="skip the sensitivity")
     add_study_options(a, "ablation")
 
+
+def add_worker_command(sub):
+    """worker: a Dask worker with this clone's build."""
     w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/experiments.md)",
                        description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "
                                    "its services (--bin-dir) as the binaries of every run; runs until stopped "
@@ -277,6 +290,17 @@ def build_parser():
     w.add_argument("--bin-dir", default=str(DEFAULT_BIN), help="service executables (default %(default)s)")
     w.add_argument("--name", help="worker name shown in the client's per-worker counts (default: its address)")
     w.add_argument("--no-nanny", action="store_true", help="no nanny process (a killed worker is not restarted)")
+
+
+def build_parser():
+    p = Parser(prog="mft-experiment", description=DESCRIPTION,
+               formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,terrain-scan,ablation,worker}", parser_class=Parser)
+    sub.required = True
+
+    for add in (add_push_sweep_command, add_case_command, add_terrain_command, add_terrain_scan_command,
+                add_ablation_command, add_worker_command):
+        add(sub)
     return p
 
 

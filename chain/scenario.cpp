@@ -95,6 +95,11 @@ Scenario read(StrictNode& root) {
         const std::string leg = oneOf(p, "at_liftoff", {"right", "left"});
         push.at_liftoff_leg = leg == "right" ? 0 : 1;
       }
+      if (p.has("at_phase")) {
+        if (p.has("at_liftoff")) p.fail("at_phase", "a push has one trigger: at_liftoff or at_phase, not both");
+        push.at_phase = p.inRange("at_phase", 0.0, 0.999);
+        push.stance_leg = oneOf(p, "stance", {"right", "left"}) == "right" ? 0 : 1;
+      }
       s.pushes.push_back(push);
     }
   }
@@ -156,6 +161,7 @@ std::string Scenario::toJson() const {
     w.beginObject().field("impulse_Ns", p.impulse_Ns, kDigits).field("at_s", p.at_s, kDigits).key("at_liftoff");
     if (p.at_liftoff_leg < 0) w.null();
     else w.value(p.at_liftoff_leg == 0 ? "right" : "left");
+    if (p.at_phase >= 0.0) w.field("at_phase", p.at_phase, kDigits).field("stance", p.stance_leg == 0 ? "right" : "left");
     w.endObject();
   }
   w.endArray().key("profiles").raw(profilesJson(profiles));

@@ -26,6 +26,10 @@ struct ScenarioPush {
   double impulse_Ns = 0.0;  // sagittal, + forward
   double at_s = 0.0;        // applied at this time, or (with at_liftoff) armed from this time
   int at_liftoff_leg = -1;  // -1: at time; 0 right, 1 left: at that leg's next lift-off after at_s
+  // At a gait phase instead (at_phase >= 0): at the planner's phase `at_phase` (0..1) of the first step that
+  // starts after at_s with this stance leg (0 right, 1 left): the push lands at a place in the gait, not a time.
+  double at_phase = -1.0;
+  int stance_leg = -1;
 };
 
 struct Scenario {

@@ -39,8 +39,8 @@ SimNode::SimNode(const model::RobotDescription& robot, const sim::SimOptions& op
       recovery_(scenario.recovery.window_s, options.control_period_s),
       ticks_total_(static_cast<std::uint64_t>(std::llround(scenario.duration_s / options.control_period_s))) {}
 
-bool SimNode::step(const model::ActuatorCommand& command) {
-  pushes_.arm(sim_);
+bool SimNode::step(const model::ActuatorCommand& command, const GaitPhase& gait) {
+  pushes_.arm(sim_, gait);
   sim_.setCommand(command);
   sim_.step();
   const auto& truth = sim_.groundTruth();

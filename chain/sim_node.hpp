@@ -25,9 +25,11 @@ class SimNode {
   SimNode(const model::RobotDescription& robot, const sim::SimOptions& options, const sim::Terrain& terrain,
           const Scenario& scenario, double settle_time_s);
 
-  // One control period with `command`: arms the due scenario pushes, steps, then updates the monitor and the
-  // recovery window. Returns true at the first fall. Never allocates (beyond the simulator's impulse log).
-  bool step(const model::ActuatorCommand& command);
+  // One control period with `command`: arms the due scenario pushes (`gait`: the planner's phase this tick, for
+  // pushes at a gait phase), steps, then updates the monitor and the recovery window. Returns true at the first
+  // fall. Never allocates (beyond the simulator's impulse log).
+  bool step(const model::ActuatorCommand& command, const GaitPhase& gait = {});
+  const ScenarioPushes& pushes() const { return pushes_; }
   // A push from outside the scenario (an operator's), applied by the simulator's rule for its trigger.
   void schedule(const sim::ImpulseSpec& push) { sim_.scheduleImpulse(push); }
 

@@ -14,6 +14,7 @@
 #include "services/runtime/convert.hpp"
 #include "services/sim/check_scenario.hpp"
 #include "services/sim/sim_summary.hpp"
+#include "services/sim/gait_link.hpp"
 #include "services/sim/tick_exchange.hpp"
 
 using namespace mft;
@@ -66,6 +67,7 @@ static int toolMain(int argc, char** argv) {
   services::HopTrace hops("mft-sim", {"publish", "published", "command_in", "wake", "stepped"});
   services::CommandLink link(ctx, hops, ctx.robot().actuator.outputPeakTorque(), watchdog_ns);
   services::TopicPushes pushes(ctx, link, cli.getDouble("max-push", 0.0, 1e4), options.control_period_s);
+  const auto gait = services::makeGaitLink(ctx, scenario);  // only for pushes at a gait phase
   services::RecorderFlow recorder(ctx, static_cast<std::uint64_t>(cli.getInt("recorder-window", 0, 1000000)),
                                   link.mutex(), link.arrived());
   services::TopicWriter<msg::SensorData, msg::SensorDataPubSubType> sensor_writer(ctx.participant(), "SensorData", ctx.chainWriterProfile());
@@ -113,7 +115,9 @@ static int toolMain(int argc, char** argv) {
     model::ActuatorCommand command;
     if (!exchange.commandFor(k, node->time(), publish, &command, &error)) break;
     pushes.scheduleInto(*node);
-    const bool fell_now = node->step(command);
+    const bool fell_now = node->step(command, gait && node->pushes().phasePushesWaiting()
+                                                  ? gait->forTick(k, std::chrono::milliseconds(2000))
+                                                  : chain::GaitPhase{});
     hops.mark(4, k);
     pushes.reportApplied(*node, k);
     if (fell_now) {

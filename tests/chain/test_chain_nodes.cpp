@@ -91,6 +91,44 @@ TEST(SimNode, PlaysAScenarioPushAtItsTimeAndReportsIt) {
   EXPECT_FALSE(node.monitor().fell());
 }
 
+// A push at a gait phase fires in the first step that starts after its time with its stance leg, at the tick
+// the planner's phase reaches it: not in the step in progress when armed, not on the other stance leg, and never
+// without the planner's phase.
+TEST(SimNode, PlaysAPushAtAGaitPhaseWhereThePlannerSaysItIs) {
+  auto s = scenario();
+  chain::ScenarioPush push{4.0, 0.01, -1};
+  push.at_phase = 0.5;
+  push.stance_leg = 1;  // left stance
+  s.pushes.push_back(push);
+  const std::string dir = MFT_CONFIG_DIR;
+  const auto robot = model::loadRobotDescription(dir + "/robot.yaml");
+  const auto options = sim::loadSimOptions(dir + "/sim.yaml");
+  chain::SimNode node(robot, options, sim::loadTerrain(dir + "/terrain/flat.yaml"), s, 1.0);
+  model::ActuatorCommand hold;
+  hold.mode = model::CommandMode::Damping;
+  // A made-up gait of 20-tick steps, left stance on odd steps: the phase is the place in the step.
+  const auto gaitAt = [](std::uint64_t k) {
+    const std::uint64_t step = 1 + k / 20;
+    return chain::GaitPhase{true, step, static_cast<double>(k % 20) / 20.0, step % 2 == 1 ? 1 : 0};
+  };
+  std::uint64_t applied_at = 0;
+  while (node.tick() < node.ticksTotal()) {
+    const std::uint64_t k = node.tick();
+    hold.tick = k;
+    node.step(hold, k < 5 ? chain::GaitPhase{} : gaitAt(k));  // no phase known before tick 5
+    if (node.firstNewImpulse() < node.simulator().stats().impulses.size()) applied_at = k;
+  }
+  // Armed at tick 10 (0.01 s) in step 1 (left stance, phase 0.5 already): that step does not count; step 2 is
+  // right stance; step 3 (ticks 40-59) is the next left-stance step: phase 0.5 at tick 50.
+  ASSERT_EQ(node.simulator().stats().impulses.size(), 1u);
+  EXPECT_EQ(applied_at, 50u);
+  EXPECT_FALSE(node.pushes().phasePushesWaiting());
+  chain::SimNode blind(robot, options, sim::loadTerrain(dir + "/terrain/flat.yaml"), s, 1.0);
+  while (blind.tick() < blind.ticksTotal()) blind.step(hold);
+  EXPECT_TRUE(blind.simulator().stats().impulses.empty());
+  EXPECT_TRUE(blind.pushes().phasePushesWaiting());
+}
+
 // The layer rule (docs/architecture.md): the chain library includes no transport, no recording and nothing of
 // services/, so a robot's bridge or the in-process loop can use it without them.
 TEST(ChainLibrary, IncludesNoTransportNoRecordingNoServices) {

@@ -50,6 +50,22 @@ TEST(Scenario, PushesAtTimeAndAtLiftoff) {
   EXPECT_DOUBLE_EQ(s.pushes[1].impulse_Ns, -2.5);
 }
 
+TEST(Scenario, PushAtAGaitPhase) {
+  const Scenario s = parseScenario(stepText() + "pushes:\n  - {impulse_Ns: 5, at_s: 3, at_phase: 0.25, stance: left}\n",
+                                   "g.yaml");
+  ASSERT_EQ(s.pushes.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.pushes[0].at_phase, 0.25);
+  EXPECT_EQ(s.pushes[0].stance_leg, 1);
+  EXPECT_EQ(s.pushes[0].at_liftoff_leg, -1);
+  EXPECT_NE(s.toJson().find("\"at_phase\": 0.25"), std::string::npos);
+  EXPECT_THROW(parseScenario(stepText() + "pushes:\n  - {impulse_Ns: 5, at_s: 3, at_phase: 0.25, stance: left, "
+                                          "at_liftoff: right}\n", "g.yaml"), ConfigError);
+  EXPECT_THROW(parseScenario(stepText() + "pushes:\n  - {impulse_Ns: 5, at_s: 3, at_phase: 1.5, stance: left}\n",
+                             "g.yaml"), ConfigError);
+  EXPECT_THROW(parseScenario(stepText() + "pushes:\n  - {impulse_Ns: 5, at_s: 3, at_phase: 0.5}\n", "g.yaml"),
+               ConfigError);
+}
+
 TEST(Scenario, UnknownTopLevelKey) { expectError("duration_s: 10.0", "duration_s: 10.0\nspeed: 3", "unknown key speed"); }
 TEST(Scenario, UnknownKeyInsideAListItem) {
   expectError("    v_cmd_mps: 0.0", "    v_cmd_mps: 0.0\n    colour: red", "commands[0].colour");

@@ -89,7 +89,9 @@ bool ClosedLoop::step() {
   planner_->applyScenarioCommands(estimate_.time_s, [](const planner::OperatorCommand&, const planner::CommandResult& r) {
     if (!r.accepted) std::fprintf(stderr, "closed loop: command rejected: %s\n", r.reason.c_str());
   });
-  const bool fell_now = sim_->step(wbc_->update(estimate_, planner_->plan(estimate_)));
+  const auto& command = wbc_->update(estimate_, planner_->plan(estimate_));
+  const auto& plan = planner_->output();
+  const bool fell_now = sim_->step(command, {true, plan.step_index, plan.phase, plan.stance_leg});
   // mft-sim's height command for the statistics: the one in force at the new time.
   z_cmd_ = chain::commandedHeight(scenario_, sim_->time());
   accumulate();

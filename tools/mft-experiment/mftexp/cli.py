@@ -20,6 +20,8 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
               and a side-by-side video (terrain.mp4)
   terrain-scan  the course walked in process from many start offsets (the gait's phase at the board's edge):
               how often each height, speed and controller gets over it; terrain_scan.md/.csv/.png
+  recovery-map  recovery probability over impulse, gait phase (8 per cycle) and direction, in process by
+              default: I_50 / I_90, I_max per phase, outcomes by cause; table.md, heatmaps.png, probability.png
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
   worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/experiments.md)
@@ -292,14 +294,20 @@ def add_worker_command(sub):
     w.add_argument("--no-nanny", action="store_true", help="no nanny process (a killed worker is not restarted)")
 
 
+def add_recovery_map_command(sub):
+    """recovery-map: the recovery probability over impulse, gait phase and direction (mftexp.recovery_args)."""
+    from . import recovery_args
+    recovery_args.add_parser(sub, heights_list, controllers_list, positive, add_common, add_distributed)
+
+
 def build_parser():
     p = Parser(prog="mft-experiment", description=DESCRIPTION,
                formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,terrain-scan,ablation,worker}", parser_class=Parser)
+    sub = p.add_subparsers(dest="command", metavar="{push-sweep,case,terrain,terrain-scan,recovery-map,ablation,worker}", parser_class=Parser)
     sub.required = True
 
     for add in (add_push_sweep_command, add_case_command, add_terrain_command, add_terrain_scan_command,
-                add_ablation_command, add_worker_command):
+                add_recovery_map_command, add_ablation_command, add_worker_command):
         add(sub)
     return p
 
@@ -421,7 +429,7 @@ def main(argv=None):
                              (("mft-record", "mft-export") if args.command in ("case", "terrain") or
                               getattr(args, "keep_rawlogs", False) else ()) +
                              (("mft-closedloop",) if getattr(args, "inprocess", False) or
-                              args.command == "terrain-scan" else ()))
+                              args.command in ("terrain-scan", "recovery-map") else ()))
         if args.command == "push-sweep":
             return cmd_push_sweep(args)
         if args.command in ("case", "terrain"):
@@ -433,6 +441,11 @@ def main(argv=None):
         if args.command == "terrain":
             from .terrain import cmd_terrain
             return cmd_terrain(args)
+        if args.command == "recovery-map":
+            from .recovery_map import cmd_recovery_map
+            args.out = args.out or str(REPO / "runs" / f"recovery-map-{time.strftime('%Y%m%d-%H%M%S')}")
+            use_snapshot(args)
+            return cmd_recovery_map(args)
         if args.command == "terrain-scan":
             from .terrain_scan import cmd_terrain_scan
             args.out = args.out or str(REPO / "runs" / f"terrain-scan-{time.strftime('%Y%m%d-%H%M%S')}")

@@ -29,11 +29,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "python"))
 from mftstack.scripts import run_script, script_parser  # noqa: E402
 from mftstack.paths import REPO, SUPERVISOR  # noqa: E402
 from mftstack.testing import child_processes, pid_alive  # noqa: E402
+from mftstack import topics as topic_registry  # noqa: E402
 
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record"]
-TOPICS = ["SensorData", "GroundTruth", "RobotState", "OperatorCommand", "Reference", "JointCommand",
-          "WbcDiagnostics", "Disturbance"]
-EVENT_TOPICS = {"OperatorCommand", "Disturbance"}
+# The topics the matrix corrupts, and which of them are events (idl/topics.yaml: faults, qos event).
+REGISTRY = topic_registry.load()
+TOPICS = REGISTRY.names(faults=True)
+EVENT_TOPICS = set(REGISTRY.names(faults=True, qos="event"))
 WATCHDOG_MS = 3.0
 
 
@@ -316,13 +318,11 @@ class Matrix:
             saf = wbc.get("safety") or {}
             if saf.get("damping_ticks") or saf.get("hold_ticks"):
                 parts.append(f"WBC safety: hold {saf.get('hold_ticks')} / damping {saf.get('damping_ticks')} ticks")
-            consumers = {"SensorData": "estimator", "GroundTruth": "estimator (init only), recorder",
-                         "RobotState": "planner, WBC", "OperatorCommand": "planner", "Reference": "WBC",
-                         "JointCommand": "sim", "WbcDiagnostics": "recorder only", "Disturbance": "sim"}
+            consumers = ", ".join(REGISTRY.topic(row.target).subscribers())
             refusals = sum(refused.values()) + sum(rej.values() if rej else [0]) + (sim.get("disturbances_rejected") or 0) \
                 + (pln.get("rejected_commands") or 0)
             row.detection = ("input checks: refused on arrival (0 ms)" if refusals else
-                             f"not refused (read by: {consumers[row.target]})")
+                             f"not refused (read by: {consumers})")
             row.detection_ms = 0.0 if refusals else None
             parts.append(f"damping {damping_ms:.0f} ms" if damping_ms >= 5 else "no damping")
             parts.append(fell)

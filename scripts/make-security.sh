@@ -8,14 +8,13 @@
 #
 # Per identity: <name>.pem (certificate), <name>.key (private key, mode 600), permissions_<name>.p7s;
 # shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/security.md).
-# Permissions: each service may publish only its own topics; only the sim publishes SensorData/GroundTruth,
-# only the WBC JointCommand; the recorder subscribes to every topic and publishes only its RecorderProgress (lockstep flow control); cmd publishes
-# OperatorCommand, Disturbance and ConfigChange only and reads the CommandVerdict the planner, the WBC and the sim
-# answer with (the planner and the WBC publish the ConfigChange they applied, for the recorder).
+# Permissions: those of the topic registry idl/topics.yaml (its writers and readers; the recorder reads every
+# recorded topic): each service may publish only its own topics (only the sim SensorData/GroundTruth, only the
+# WBC JointCommand); cmd publishes the operator's commands and reads the CommandVerdict answering them.
 set -euo pipefail
 
 usage() {
-  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'
   echo
   echo "Options:"
   echo "  --profile data   governance with data-only ENCRYPT on every topic, discovery and liveliness encrypted,"
@@ -48,6 +47,7 @@ done
 case "$PROFILE" in data|full) ;; *) echo "make-security: --profile must be data or full, got '$PROFILE'" >&2; exit 2 ;; esac
 [[ "$DAYS" =~ ^[0-9]+$ ]] && [ "$DAYS" -ge 1 ] || { echo "make-security: --days must be a positive integer" >&2; exit 2; }
 command -v openssl >/dev/null || { echo "make-security: openssl not found (apt-get install openssl)" >&2; exit 2; }
+command -v python3 >/dev/null || { echo "make-security: python3 not found (it reads the topic registry)" >&2; exit 2; }
 
 REPO="$(cd "$(dirname "$0")/.." && pwd -P)"
 mkdir -p "$DIR"
@@ -64,25 +64,14 @@ chmod 700 "$DIR"
 umask 077
 cd "$DIR"
 
-IDENTITIES=(sim estimator planner wbc record cmd)
-ALL_TOPICS=(SensorData GroundTruth RobotState OperatorCommand Reference JointCommand WbcDiagnostics Disturbance ConfigChange)
-# Who may publish / subscribe what (docs/architecture.md#topics; mft-cmd publishes operator commands and pushes).
-declare -A PUB=(
-  [sim]="SensorData GroundTruth CommandVerdict"
-  [estimator]="RobotState"
-  [planner]="Reference CommandVerdict ConfigChange"
-  [wbc]="JointCommand WbcDiagnostics CommandVerdict ConfigChange"
-  [record]="RecorderProgress"
-  [cmd]="OperatorCommand Disturbance ConfigChange"
-)
-declare -A SUB=(
-  [sim]="JointCommand Disturbance RecorderProgress"
-  [estimator]="SensorData GroundTruth"
-  [planner]="RobotState OperatorCommand ConfigChange"
-  [wbc]="RobotState Reference ConfigChange"
-  [record]="${ALL_TOPICS[*]}"
-  [cmd]="CommandVerdict"
-)
+# Who may publish / subscribe what: the writers and readers of the topic registry (idl/topics.yaml,
+# docs/architecture.md#the-topic-registry), one line per identity and direction: "<id> pub|sub <topics...>".
+GRANTS="$(python3 "$REPO/idl/gen_topics.py" security)" || { echo "make-security: cannot read the topic registry idl/topics.yaml" >&2; exit 2; }
+IDENTITIES=()
+declare -A PUB=() SUB=()
+while read -r id dir topics; do
+  [ "$dir" = pub ] && { IDENTITIES+=("$id"); PUB[$id]="$topics"; } || SUB[$id]="$topics"
+done <<< "$GRANTS"
 
 echo "make-security: test CA and ${#IDENTITIES[@]} identities in $DIR (profile $PROFILE, $DAYS days)"
 # EC P-256 everywhere (docs/dds.md#security: works with Fast DDS 2.9.1 and OpenSSL 3).

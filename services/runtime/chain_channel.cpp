@@ -35,11 +35,8 @@ std::string errnoText(const std::string& what, const std::string& name) {
 }  // namespace
 
 int chainSlotIndex(const std::string& topic_name) {
-  static const char* const kTopics[ChainChannel::kSlots] = {"SensorData", "GroundTruth", "RobotState", "Reference",
-                                                             "JointCommand", "WbcDiagnostics"};
-  for (int i = 0; i < ChainChannel::kSlots; ++i)
-    if (topic_name == kTopics[i]) return i;
-  return -1;
+  const int row = msg::topicIndex(topic_name);
+  return row < 0 ? -1 : msg::kTopics[static_cast<std::size_t>(row)].chain_slot;
 }
 
 ChainChannel::ChainChannel(const std::string& name) : name_(name) {

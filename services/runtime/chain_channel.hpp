@@ -1,8 +1,9 @@
 #pragma once
 // The chain's shared-memory channel (docs/loop-benchmark.md, "The shared-memory chain channel"): the topics
-// the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics go
-// between the processes of one stack (the four chain services and the recorder) through a POSIX shared-memory
-// segment the supervisor names, instead of through the DDS stack. Each topic has one slot: a ring of the last
+// the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics
+// (the rows of idl/topics.yaml with `chain: true`) go between the processes of one stack (the four chain services
+// and the recorder) through a POSIX shared-memory segment the supervisor names, instead of through the DDS stack.
+// Each topic has one slot: a ring of the last
 // kRing samples' serialized bytes, each entry guarded by its own sequence word (a seqlock), and a head counter
 // that is also the futex the chain's readers sleep on. A write is a copy and, when a reader sleeps, one
 // FUTEX_WAKE: a hop costs about one thread wake-up instead of a UDP send, a receive and a listener dispatch.
@@ -27,6 +28,8 @@
 #include <string>
 #include <thread>
 
+#include "mft_topic_table.hpp"
+
 namespace mft::services {
 
 class ChainChannelError : public std::runtime_error {
@@ -34,14 +37,15 @@ class ChainChannelError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The topics the channel carries, by the logical names TopicWriter/TopicReader are given; -1 for any other.
+// The slot of a topic, by the logical name TopicWriter/TopicReader are given; -1 for a topic the channel does not
+// carry. The slots are the rows of the topic registry with `chain: true` (idl/topics.yaml), in its order.
 int chainSlotIndex(const std::string& topic_name);
 
 class ChainChannel {
  public:
   static constexpr std::size_t kSlotBytes = 2048;  // larger than every chain topic's serialized size (checked)
   static constexpr std::uint32_t kRing = 256;      // more than the simulator's recorder window (200 ticks)
-  static constexpr int kSlots = 6;
+  static constexpr int kSlots = msg::kChainSlots;
 
   struct Entry {
     alignas(64) std::atomic<std::uint32_t> seq;  // sample n: 2n+1 while written, 2n+2 once whole

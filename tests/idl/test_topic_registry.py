@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""The topic registry (idl/topics.yaml with idl/mft_msgs.idl, docs/architecture.md#the-topic-registry): the
+copies kept in the repository (ros2/mft, the docs' topic table) are what the registry makes of them, the
+permissions it gives are those the stack was secured with before it existed, and a bad row is refused with
+its reason."""
+import subprocess
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
+from mftstack import topics  # noqa: E402
+from mftstack.paths import REPO  # noqa: E402
+
+GEN = REPO / "idl" / "gen_topics.py"
+# scripts/make-security.sh's hand-written PUB/SUB tables, as they were when the registry replaced them.
+PERMISSIONS_BEFORE = {
+    "sim": ("SensorData GroundTruth CommandVerdict", "JointCommand Disturbance RecorderProgress"),
+    "estimator": ("RobotState", "SensorData GroundTruth"),
+    "planner": ("Reference CommandVerdict ConfigChange", "RobotState OperatorCommand ConfigChange"),
+    "wbc": ("JointCommand WbcDiagnostics CommandVerdict ConfigChange", "RobotState Reference ConfigChange"),
+    "record": ("RecorderProgress", "SensorData GroundTruth RobotState OperatorCommand Reference JointCommand "
+                                   "WbcDiagnostics Disturbance ConfigChange"),
+    "cmd": ("OperatorCommand Disturbance ConfigChange", "CommandVerdict"),
+}
+
+
+def gen(*args):
+    return subprocess.run([sys.executable, str(GEN), *args], capture_output=True, text=True, timeout=60)
+
+
+class TopicRegistry(unittest.TestCase):
+    def test_kept_copies_are_generated(self):
+        r = gen("check")
+        self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_every_message_has_one_row_and_the_chain_keeps_its_slots(self):
+        reg = topics.load()
+        self.assertEqual([t.type for t in reg.topics], list(reg.structs))
+        self.assertEqual(reg.names(chain=True), ["SensorData", "GroundTruth", "RobotState", "Reference",
+                                                 "JointCommand", "WbcDiagnostics"])
+        self.assertEqual(reg.names(faults=True), ["SensorData", "GroundTruth", "RobotState", "OperatorCommand",
+                                                  "Reference", "JointCommand", "WbcDiagnostics", "Disturbance"])
+
+    def test_permissions_are_those_of_before(self):
+        reg = topics.load()
+        for identity, (pub, sub) in PERMISSIONS_BEFORE.items():
+            got_pub, got_sub = reg.permissions(identity)
+            self.assertEqual(sorted(got_pub), sorted(pub.split()), identity)
+            self.assertEqual(sorted(got_sub), sorted(sub.split()), identity)
+        lines = gen("security").stdout.splitlines()
+        self.assertIn("cmd pub OperatorCommand Disturbance ConfigChange", lines)
+
+    def test_bad_rows_are_refused_with_the_reason(self):
+        good = (REPO / "idl" / "topics.yaml").read_text()
+        cases = {"wire: rt/mft/sensor_data": ("wire: rt/mft/sensors", "is not ROS 2's name"),
+                 "writers: [sim]": ("writers: [simulator]", "not a security identity"),
+                 "qos: progress": ("qos: fast", "is not one of"),
+                 "bad_values: {mode: 99}": ("bad_values: {mood: 99}", "not a field of OperatorCommand")}
+        with tempfile.TemporaryDirectory() as d:
+            for old, (new, why) in cases.items():
+                p = Path(d) / "topics.yaml"
+                p.write_text(good.replace(old, new, 1))
+                r = gen("list", "--registry", str(p))
+                self.assertEqual(r.returncode, 2, new)
+                self.assertIn(why, r.stderr)
+            p.write_text(good.replace("  - type: ConfigChange", "  - type: ConfigChanges", 1))
+            r = gen("list", "--registry", str(p))
+            self.assertEqual(r.returncode, 2)
+            self.assertIn("no struct ConfigChanges_", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)

@@ -4,10 +4,8 @@
 // In a lockstep stack on the chain channel (--chain-shm), the 1 kHz topics come from the channel's rings instead
 // (services/runtime/chain_channel.hpp), drained by one thread every millisecond: the writers then send nothing
 // over DDS for the recorder.
-// Not recorded: CommandVerdict (the stack's answer to mft-cmd). Its reason is text, which rawlog schema 1's
-// numeric channels cannot hold, and a new topic would change the schema that older recordings and tools share;
-// the commands themselves are recorded, and each verdict (with the tick a command was applied at) is in the
-// planner's and simulator's logs and summaries (docs/operator-commands.md).
+// The topics are the registry's rows with `record: true` (idl/topics.yaml); a row the rawlog cannot hold yet
+// (no alternative of rawlog::Message) is a compile error, not a silent gap.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -16,6 +14,7 @@
 #include <string>
 #include <thread>
 #include <type_traits>
+#include <vector>
 
 #include <fastdds/rtps/common/SerializedPayload.h>
 
@@ -27,15 +26,26 @@
 
 #include "services/record/record_participant.hpp"
 #include "services/record/recorder.hpp"
+#include "idl/msg_pubsub.hpp"
 #include "services/runtime/chain_channel.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "services/runtime/topic_names.hpp"
 
 namespace mft::services {
 
+// What the table asks of every topic, whatever its type.
+class RecordedTopic {
+ public:
+  virtual ~RecordedTopic() = default;
+  virtual std::uint64_t drainChannel(std::uint64_t max_samples) = 0;
+  virtual std::uint64_t received() const = 0;
+  virtual std::uint64_t lastTick() const = 0;
+  virtual std::uint64_t channelLost() const = 0;
+};
+
 // One topic into the recorder.
-template <class Msg, class PubSubType>
-class Subscription : public eprosima::fastdds::dds::DataReaderListener {
+template <class Msg, class PubSubType = typename msg::PubSubOf<Msg>::type>
+class Subscription : public eprosima::fastdds::dds::DataReaderListener, public RecordedTopic {
  public:
   Subscription(RecordParticipant& p, const std::string& topic_name, const std::string& profile, rawlog::Recorder& rec,
                bool best_effort = false, ChainChannel* channel = nullptr)
@@ -67,15 +77,15 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
   }
   // On the chain channel: the samples written since the last call, at most `max_samples`, from the caller's (the
   // drainer's) thread; how many.
-  std::uint64_t drainChannel(std::uint64_t max_samples) {
+  std::uint64_t drainChannel(std::uint64_t max_samples) override {
     if (!archive_) return 0;
     return archive_->drain([this](const unsigned char* bytes, std::size_t size) {
       if (fromChainBytes(type_, payload_, bytes, size, &sample_)) take();
     }, max_samples);
   }
-  std::uint64_t received() const { return received_.load(std::memory_order_relaxed); }
-  std::uint64_t lastTick() const { return last_tick_.load(std::memory_order_relaxed); }
-  std::uint64_t channelLost() const { return archive_ ? archive_->lost() : 0; }
+  std::uint64_t received() const override { return received_.load(std::memory_order_relaxed); }
+  std::uint64_t lastTick() const override { return last_tick_.load(std::memory_order_relaxed); }
+  std::uint64_t channelLost() const override { return archive_ ? archive_->lost() : 0; }
 
  private:
   void take() {
@@ -99,19 +109,24 @@ class Subscription : public eprosima::fastdds::dds::DataReaderListener {
 
 // Every recorded topic. The 1 kHz chain's readers use `chain_profile` (best effort with `best_effort`: the chain's
 // writers offer best effort in both modes, lockstep recovers a lost sample by re-sending the tick, and a reader
-// asking for more would not match; losses show as tick gaps, re-sent ticks as repeats).
+// asking for more would not match; losses show as tick gaps, re-sent ticks as repeats); events use event_reader.
 struct TopicTable {
   TopicTable(RecordParticipant& p, rawlog::Recorder& r, const std::string& chain_profile, bool best_effort,
-             ChainChannel* channel = nullptr)
-      : truth(p, "GroundTruth", chain_profile, r, best_effort, channel),
-        sensors(p, "SensorData", chain_profile, r, best_effort, channel),
-        state(p, "RobotState", chain_profile, r, best_effort, channel),
-        reference(p, "Reference", chain_profile, r, best_effort, channel),
-        command(p, "JointCommand", chain_profile, r, best_effort, channel),
-        diagnostics(p, "WbcDiagnostics", chain_profile, r, best_effort, channel),
-        operator_command(p, "OperatorCommand", "event_reader", r),
-        disturbance(p, "Disturbance", "event_reader", r),
-        config_change(p, "ConfigChange", "event_reader", r) {
+             ChainChannel* channel = nullptr) {
+    msg::forEachTopicType([&](auto tag) {
+      using M = typename decltype(tag)::type;
+      constexpr const msg::TopicInfo& info = msg::topicInfo<M>();
+      if constexpr (info.recorded) {
+        static_assert(std::is_constructible_v<rawlog::Message, M>, "a recorded topic the rawlog cannot hold");
+        const bool stream = info.qos == msg::TopicQos::Chain;
+        auto sub = std::make_unique<Subscription<M>>(p, std::string(info.type), stream ? chain_profile : "event_reader",
+                                                     r, stream && best_effort, stream ? channel : nullptr);
+        if (stream) streams_.emplace_back(rawlog::Message(M{}).index(), sub.get());
+        all_.push_back(std::move(sub));
+      }
+    });
+    // In the rawlog's topic order (the simulator's outputs first), the order a tick's samples are drained in.
+    std::sort(streams_.begin(), streams_.end());
     if (channel) drainer_ = std::thread([this] { drainLoop(); });
   }
   ~TopicTable() {
@@ -119,15 +134,13 @@ struct TopicTable {
     if (drainer_.joinable()) drainer_.join();
   }
   // Samples the ring overwrote before the drainer took them (zero while the simulator's recorder window holds).
-  std::uint64_t channelLost() const {
-    return truth.channelLost() + sensors.channelLost() + state.channelLost() + reference.channelLost() +
-           command.channelLost() + diagnostics.channelLost();
-  }
+  std::uint64_t channelLost() const { return sum(&RecordedTopic::channelLost); }
 
   // Every 1 kHz topic has delivered at least one sample.
   bool flowing() const {
-    return truth.received() && sensors.received() && state.received() && reference.received() && command.received() &&
-           diagnostics.received();
+    for (const auto& [order, s] : streams_)
+      if (!s->received()) return false;
+    return true;
   }
   // The tick the simulator's window counts from. Over DDS: the newest tick seen on any 1 kHz topic (the socket is a
   // FIFO: everything sent before it has been taken in, or was lost, and waiting for it would deadlock the run).
@@ -135,28 +148,16 @@ struct TopicTable {
   // the other by a background thread that may stop between two (the window must cover the slowest ring).
   std::uint64_t newestTick() const {
     if (drainer_.joinable()) return allTopicsTick();
-    return std::max({truth.lastTick(), sensors.lastTick(), state.lastTick(), reference.lastTick(), command.lastTick(),
-                     diagnostics.lastTick()});
+    std::uint64_t t = 0;
+    for (const auto& [order, s] : streams_) t = std::max(t, s->lastTick());
+    return t;
   }
   std::uint64_t allTopicsTick() const {
-    return std::min({truth.lastTick(), sensors.lastTick(), state.lastTick(), reference.lastTick(), command.lastTick(),
-                     diagnostics.lastTick()});
+    std::uint64_t t = ~std::uint64_t{0};
+    for (const auto& [order, s] : streams_) t = std::min(t, s->lastTick());
+    return streams_.empty() ? 0 : t;
   }
-  std::uint64_t chainReceived() const {
-    return truth.received() + sensors.received() + state.received() + reference.received() + command.received() +
-           diagnostics.received();
-  }
-
-  Subscription<msg::GroundTruth, msg::GroundTruthPubSubType> truth;
-  Subscription<msg::SensorData, msg::SensorDataPubSubType> sensors;
-  Subscription<msg::RobotState, msg::RobotStatePubSubType> state;
-  Subscription<msg::Reference, msg::ReferencePubSubType> reference;
-  Subscription<msg::JointCommand, msg::JointCommandPubSubType> command;
-  Subscription<msg::WbcDiagnostics, msg::WbcDiagnosticsPubSubType> diagnostics;
-  Subscription<msg::OperatorCommand, msg::OperatorCommandPubSubType> operator_command;
-  Subscription<msg::Disturbance, msg::DisturbancePubSubType> disturbance;
-  // Live tuning: the requests and the changes the WBC and the planner applied, with their ticks (label config_change).
-  Subscription<msg::ConfigChange, msg::ConfigChangePubSubType> config_change;
+  std::uint64_t chainReceived() const { return sum(&RecordedTopic::received); }
 
  private:
   // A few ticks of every ring at a time, so the recorder gets the topics interleaved as over DDS: its writer
@@ -166,9 +167,8 @@ struct TopicTable {
     constexpr std::uint64_t kTicksPerPass = 2;
     std::uint64_t taken = 0;
     do {
-      taken = truth.drainChannel(kTicksPerPass) + sensors.drainChannel(kTicksPerPass) + state.drainChannel(kTicksPerPass) +
-              reference.drainChannel(kTicksPerPass) + command.drainChannel(kTicksPerPass) +
-              diagnostics.drainChannel(kTicksPerPass);
+      taken = 0;
+      for (const auto& [order, s] : streams_) taken += s->drainChannel(kTicksPerPass);
     } while (taken > 0);
   }
   // Every millisecond, as the polling UDP path drains its sockets: a tick's six samples come in one pass.
@@ -179,6 +179,14 @@ struct TopicTable {
     }
     drainChannel();  // what came during the last sleep
   }
+  // Over the 1 kHz topics.
+  std::uint64_t sum(std::uint64_t (RecordedTopic::*what)() const) const {
+    std::uint64_t n = 0;
+    for (const auto& [order, s] : streams_) n += (s->*what)();
+    return n;
+  }
+  std::vector<std::unique_ptr<RecordedTopic>> all_;
+  std::vector<std::pair<std::size_t, RecordedTopic*>> streams_;  // the 1 kHz topics (qos chain), by rawlog order
   std::atomic<bool> stop_{false};
   std::thread drainer_;
 };

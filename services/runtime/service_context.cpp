@@ -16,6 +16,8 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
+  cli.option("rt-priority", "with --rt: the SCHED_FIFO priority (the supervisor's --rt-chain-order gives the chain's "
+             "services rising priorities along the chain)", "80");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "
              "comma list; docs/profiles.md)");
@@ -57,7 +59,7 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   const std::string chain_shm = cli.get("chain-shm");
   if (!chain_shm.empty() && !cli.get("secure").empty())
     cli.fail("--chain-shm: not with --secure (it would bypass DDS access control)");
-  if (cli.isSet("rt")) tryRealtimeScheduling(80);
+  if (cli.isSet("rt")) tryRealtimeScheduling(static_cast<int>(cli.getInt("rt-priority", 1, 98)));
   try {
     participant_ = std::make_unique<DdsParticipant>(domain, profilesFile(cli), service,
                                                     SecurityOptions{cli.get("secure"), securityIdentity(service)});

@@ -35,6 +35,8 @@ static int toolMain(int argc, char** argv) {
   cli.option("stall-probe-us", "realtime: period of the CPU stall probe (one SCHED_FIFO thread per CPU that tells\n"
              "                             the machine's stalls from the chain's misses; costs ~30 us of p50 latency\n"
              "                             on a 2-vCPU VM; 0 = off) [us]", "0");
+  cli.option("spin-us", "realtime: wake this long before each 1 kHz deadline and poll the clock to it (0 = sleep to\n"
+             "                             the deadline; docs/loop-benchmark.md) [us]", "0");
   cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
   cli.option("recorder-window", "lockstep: never run more than this many ticks ahead of mft-record's progress "
                                 "(0 = no recorder flow control; the supervisor sets it when recording)", "0");
@@ -106,7 +108,8 @@ static int toolMain(int argc, char** argv) {
   if (!ctx.lockstep()) std::printf("mft-sim: the chain answered tick 0: the clock starts\n");  // `up` waits for it
   std::fflush(stdout);
   const auto stall_probe = services::makeStallProbe(ctx.lockstep() ? 0 : cli.getInt("stall-probe-us", 0, 100000));
-  services::RealtimePacer pacer(options.control_period_s, watchdog_ns);
+  services::RealtimePacer pacer(options.control_period_s, watchdog_ns,
+                                std::chrono::microseconds(cli.getInt("spin-us", 0, 900)));
   services::TickExchange exchange(ctx.lockstep(), {command_timeout, start_timeout, resend}, link, recorder, pacer, hops);
   std::uint64_t last_progress_tick = 0;
   std::string error;

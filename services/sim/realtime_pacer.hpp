@@ -20,16 +20,23 @@ namespace mft::services {
 class RealtimePacer {
  public:
   using Clock = std::chrono::steady_clock;
-  RealtimePacer(double period_s, std::int64_t watchdog_timeout_ns)
+  // spin: the last part of each period is spent polling the clock instead of asleep (0: sleep to the deadline).
+  // A sleep ends late by the timer's and the scheduler's lateness; waking `spin` early and polling trades that
+  // tail for a CPU busy that long per period.
+  RealtimePacer(double period_s, std::int64_t watchdog_timeout_ns, Clock::duration spin = Clock::duration::zero())
       : period_(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s))),
-        watchdog_timeout_ns_(watchdog_timeout_ns) {
+        watchdog_timeout_ns_(watchdog_timeout_ns),
+        spin_(std::min(spin, period_)) {
     onset_late_ms_.reserve(64);
   }
   void start(Clock::time_point t0) { next_wakeup_ = t0; }
+  Clock::time_point deadline() const { return next_wakeup_; }
   // Sleeps until the next period's deadline and books how late it woke up.
   void sleep() {
     next_wakeup_ += period_;
-    std::this_thread::sleep_until(next_wakeup_);
+    std::this_thread::sleep_until(next_wakeup_ - spin_);
+    while (Clock::now() < next_wakeup_) {
+    }
     const double late_us = std::chrono::duration<double, std::micro>(Clock::now() - next_wakeup_).count();
     wakeup_late_us_.add(late_us);
     recent_late_us_[recent_index_++ % recent_late_us_.size()] = late_us;
@@ -51,6 +58,7 @@ class RealtimePacer {
  private:
   Clock::duration period_;
   std::int64_t watchdog_timeout_ns_;
+  Clock::duration spin_;
   Clock::time_point next_wakeup_;
   LatencyStats wakeup_late_us_;
   std::array<double, 8> recent_late_us_{};

@@ -49,6 +49,17 @@ from .summary import build_summary, print_summary, report_unwritten, write_summa
 INTERRUPT_GRACE_S = 0.8
 
 
+
+def spin_us(text):
+    """--sim-spin-us: whole microseconds, 0..900 (mft-sim's own range)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected whole microseconds, got '{text}'")
+    if not 0 <= value <= 900:
+        raise argparse.ArgumentTypeError(f"expected 0..900 us, got {value}")
+    return value
+
 def this_run_lines(path, offset, n):
     """The last n lines a detached `up` wrote to its appended log, from `offset` on (not earlier stacks')."""
     try:
@@ -342,6 +353,11 @@ def main(argv=None):
         sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
                         "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
                         "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
+        sp.add_argument("--rt-chain-order", action="store_true", help="realtime: SCHED_FIFO priorities rising along "
+                        "the chain (sim 76, estimator 77, planner 78, wbc 79) instead of 80 for all; with --chain-cpu N "
+                        "each hand-off is a same-core preemption (docs/loop-benchmark.md)")
+        sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
+                        "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
         sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
                         "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
                         "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "

@@ -81,6 +81,25 @@ def chain_shm_name(args, multi_host):
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
 
+# --rt-chain-order: SCHED_FIFO priorities rising along the chain, so that on one core each hand-off (sim ->
+# estimator -> planner -> wbc) preempts the writer at once; the WBC's command then waits for the chain's threads
+# to finish their ticks. Off by default until measured (docs/loop-benchmark.md).
+RT_CHAIN_PRIORITIES = {"mft-sim": 76, "mft-estimator": 77, "mft-planner": 78, "mft-wbc": 79}
+
+
+def realtime_options(name, args):
+    """The options of service `name` for the realtime knobs: --rt-priority with --rt-chain-order, mft-sim's
+    --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
+    if args.mode != "realtime" or getattr(args, "no_rt", False):
+        return []
+    extra = []
+    if getattr(args, "rt_chain_order", False) and name in RT_CHAIN_PRIORITIES:
+        extra += ["--rt-priority", str(RT_CHAIN_PRIORITIES[name])]
+    if name == "mft-sim" and getattr(args, "sim_spin_us", 0):
+        extra += ["--spin-us", str(args.sim_spin_us)]
+    return extra
+
+
 def cpu_placement(chain_cpu, names, recorder_elsewhere=True):
     """The chain (sim, estimator, planner, wbc) on CPU `chain_cpu` (None: no pinning); the recorder on the other
     CPUs when `recorder_elsewhere` (an explicit --chain-cpu N), else free. "auto" leaves it free: the lockstep
@@ -221,6 +240,7 @@ class Stack:
             if self.chain_shm and (name != "mft-record" or args.mode == "lockstep"):
                 # the four chain services, and in lockstep the recorder (its window keeps it inside the rings)
                 argv += ["--chain-shm", self.chain_shm]
+            argv += realtime_options(name, args)
             if name == "mft-record":
                 argv += ["--output", str(Path(args.record).resolve())] + (["--overwrite"] if args.overwrite else [])
             if name == "mft-sim" and getattr(args, "record", None) and args.mode == "lockstep" and RECORDER_WINDOW_TICKS:

@@ -17,7 +17,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import HELPER_FIFO_PRIORITY, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 from mftstack.errors import SupervisorError  # noqa: E402
-from mftstack.processes import chain_cpu_for, chain_shm_name, cpu_placement  # noqa: E402
+from mftstack.processes import chain_cpu_for, chain_shm_name, cpu_placement, realtime_options  # noqa: E402
 from mftstack.summary import gaps_in_stalls, stalled_within  # noqa: E402
 from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
@@ -94,6 +94,31 @@ class ChainPlacementTest(unittest.TestCase):
         self.assertEqual(cpu_placement(None, ["mft-wbc"]), {})
         auto = cpu_placement(allowed[0], ["mft-wbc", "mft-sim", "mft-record"], recorder_elsewhere=False)
         self.assertEqual(auto, {"mft-wbc": {allowed[0]}, "mft-sim": {allowed[0]}})  # the recorder stays free
+
+
+class RealtimeKnobsTest(unittest.TestCase):
+    """--rt-chain-order and --sim-spin-us reach the services they are for, in realtime with --rt only."""
+
+    def args(self, **kw):
+        base = dict(mode="realtime", no_rt=False, rt_chain_order=False, sim_spin_us=0)
+        base.update(kw)
+        return argparse.Namespace(**base)
+
+    def test_priorities_rise_along_the_chain(self):
+        args = self.args(rt_chain_order=True)
+        chain = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
+        prios = [int(realtime_options(n, args)[1]) for n in chain]
+        self.assertEqual(prios, sorted(prios))
+        self.assertEqual(len(set(prios)), 4)
+        self.assertTrue(all(1 <= p < 80 for p in prios))  # below the stall probe and the tests' watchers (85)
+        self.assertEqual(realtime_options("mft-record", args), [])
+
+    def test_spin_goes_to_the_simulator_alone_and_nothing_in_lockstep(self):
+        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150)), ["--spin-us", "150"])
+        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150, rt_chain_order=True)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True, rt_chain_order=True)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args()), [])
 
 
 class ChainTransportTest(unittest.TestCase):

@@ -20,7 +20,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 TOOLS = [
     ("services/mft-supervisor", ["run", "up", "status", "down", "logs"]),
     ("mft-cmd", []), ("mft-export", []), ("mft-replay", []), ("mft-record", []),
-    ("mft-experiment", ["push-sweep", "case", "terrain", "terrain-scan", "ablation", "worker"]),
+    ("mft-experiment", ["push-sweep", "case", "terrain", "terrain-scan", "recovery-map", "ablation", "worker"]),
     ("mft-closedloop", []), ("mft-space", []), ("mft-qp", []), ("mft-inject", []), ("mft-cyclone", []),
     ("mft-participants", []), ("mft-wakeup", []), ("mft-bench", []),
     ("mft-sim", []), ("mft-estimator", []), ("mft-planner", []), ("mft-wbc", []),

@@ -221,7 +221,8 @@ class RecoveryMap:
         self.progress = Progress(len(slots), quiet=self.args.quiet)
         self.progress.note(f"{len(self.rows)} rows (heights x controllers x directions x {len(self.points)} phases), "
                            f"impulses {self.impulses[0]:g}..{self.impulses[-1]:g} N s by {self.args.step:g}, "
-                           f"{'in process' if self.inprocess else 'on the stack'}, {executor.describe()}")
+                           f"{'in process' if self.inprocess else 'on the stack'}, "
+                           f"{executor.describe() if executor.kind != 'local' or not self.inprocess else f'{len(slots)} runs at a time'}")
         errors = []
 
         def worker(i):

@@ -124,8 +124,8 @@ def plot_heatmaps(path, report, runs):
     fig, axes = plt.subplots(nrows, cols, figsize=(7 * cols, 2.2 + 0.28 * len(labels) * nrows), squeeze=False)
     order = list(OUTCOME_COLOURS)
     cmap = ListedColormap([OUTCOME_COLOURS[k] for k in order])
+    grid = max((s["impulses_Ns"] for s in cells), key=len)  # one impulse axis for every cell
     for ax, s in zip(axes.flat, cells):
-        grid = s["impulses_Ns"]
         z = [[order.index("not run")] * len(grid) for _ in labels]
         for d in runs:
             if (d["height"], d["controller"], d["direction"]) == (s["height"], s["controller"], s["direction"]) \

@@ -13,7 +13,11 @@ REGISTRY = REPO / "idl" / "topics.yaml"
 
 # The DDS Security identities (scripts/make-security.sh): one per service, cmd for the operator's tools.
 IDENTITIES = ("sim", "estimator", "planner", "wbc", "record", "cmd")
-QOS_CLASSES = ("chain", "event", "progress")
+# The profiles of config/dds_profiles.xml each QoS class uses: (writers, readers).
+QOS_PROFILES = {"chain": (("lockstep_writer", "control_writer"), ("lockstep_reader", "control_reader")),
+                "event": (("command_writer", "verdict_writer", "event_writer"), ("event_reader",)),
+                "progress": (("lockstep_writer",), ("lockstep_reader",))}
+QOS_CLASSES = tuple(QOS_PROFILES)
 ROW_KEYS = {"type", "wire", "qos", "chain", "record", "writers", "readers", "faults", "bad_values", "content"}
 # IDL field types the messages use -> (C++ scalar, ROS 2 .msg type)
 IDL_TYPES = {"unsigned long long": ("std::uint64_t", "uint64"), "double": ("double", "float64"),

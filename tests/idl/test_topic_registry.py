@@ -7,6 +7,7 @@ import subprocess
 import sys
 import tempfile
 import unittest
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
@@ -51,6 +52,14 @@ class TopicRegistry(unittest.TestCase):
             self.assertEqual(sorted(got_sub), sorted(sub.split()), identity)
         lines = gen("security").stdout.splitlines()
         self.assertIn("cmd pub OperatorCommand Disturbance ConfigChange", lines)
+
+    def test_every_qos_class_names_profiles_of_dds_profiles_xml(self):
+        root = ET.parse(REPO / "config" / "dds_profiles.xml").getroot()
+        names = {e.get("profile_name") for e in root.iter() if e.get("profile_name")}
+        for qos, (writers, readers) in topics.QOS_PROFILES.items():
+            for profile in writers + readers:
+                self.assertIn(profile, names, f"qos {qos}")
+        self.assertEqual({t.qos for t in topics.load().topics}, set(topics.QOS_CLASSES))
 
     def test_bad_rows_are_refused_with_the_reason(self):
         good = (REPO / "idl" / "topics.yaml").read_text()

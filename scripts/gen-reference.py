@@ -5,7 +5,7 @@
 
 Usage: scripts/gen-reference.py [--bin-dir build/release/bin] [--check]
 --check writes nothing and exits 1, naming the page, when a committed page differs from what the build prints
-(test docs_reference). The source folder in printed default paths is shown as <source>, so the page is the same
+(test docs_reference; whitespace aside, since argparse wraps around paths of any length). The source folder in printed default paths is shown as <source>, so the page is the same
 on every machine.
 """
 import argparse
@@ -56,6 +56,12 @@ def tools_page(bin_dir):
     return "".join(parts)
 
 
+def same_words(a, b):
+    """Equal but for whitespace: argparse wraps a help line by its length, and a default path is as long as the
+    folder the build sits in."""
+    return a.split() == b.split()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--bin-dir", default=str(ROOT / "build/release/bin"))
@@ -68,7 +74,7 @@ def main():
     stale = []
     for path, text in pages.items():
         old = path.read_text(encoding="utf-8") if path.exists() else ""
-        if old == text:
+        if same_words(old, text):
             continue
         if args.check:
             diff = difflib.unified_diff(old.splitlines(), text.splitlines(), str(path), "generated", lineterm="", n=1)

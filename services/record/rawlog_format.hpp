@@ -1,19 +1,21 @@
 #pragma once
-// The mft rawlog format, schema version 1 (docs/recording.md, docs/mrpt.md): an MRPT
-// observations-only rawlog ("format #2") whose first object is a CObservationComment holding the run's
-// metadata as YAML, followed by standard MRPT observations, one or more per DDS message:
-//   CObservationRawDAQ (AIN_double, channel 0 = tick or seq) for joints, contacts, references, commands,
-//   diagnostics and events; CObservationIMU for the torso IMU (`imu`) and, as a derived "virtual INS" view,
-//   the estimated floating base (`base_est`).
+// The mft rawlog format (docs/recording.md, docs/mrpt.md): an MRPT observations-only rawlog ("format #2") whose
+// first object is a CObservationComment holding the run's metadata as YAML, followed by standard MRPT
+// observations, one or more per DDS message:
+//   CObservationRawDAQ for every topic (AIN_double: the channels, channel 0 = tick or seq; schema 2 adds the
+//   exact 64-bit integers in AIN_32bits and the text fields in AIN_8bits); CObservationIMU for the torso IMU
+//   (`imu`) and, as a derived "virtual INS" view, the estimated floating base (`base_est`).
 // Observation timestamps are the simulator's clock: time_base_unix_ns + stamp_ns (100 ns resolution).
-// Only rawlog_format.cpp knows the channel layout, as one table per label from which the writer, the reader
-// and the column names all follow: the recorder, replay and export go through it, so they cannot disagree. Never reorder channels without bumping kSchemaVersion.
+// The layout is built once from each message's fields (generated from the IDL, rawlog_layout.hpp): a topic
+// without a hand-written presentation gets one label with every field. Schema 1 files (integers as doubles
+// only, no text) still read. Never reorder channels without bumping kSchemaVersion.
 #include <mrpt/obs/CObservation.h>
 
 #include <array>
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -21,7 +23,8 @@
 
 namespace mft::rawlog {
 
-constexpr int kSchemaVersion = 1;
+constexpr int kSchemaVersion = 2;        // written
+constexpr int kOldestSchemaVersion = 1;  // read: 1 (before exact integers and text) and 2
 constexpr const char* kFormatName = "mft-rawlog";
 
 // The recorded topics, in the order messages of one tick are written (the simulator's outputs first).
@@ -34,18 +37,21 @@ enum class Topic : std::uint8_t {
   WbcDiagnostics,
   OperatorCommand,
   Disturbance,
-  ConfigChange,  // live tuning (docs/live-tuning.md): requests and the changes the services applied
+  ConfigChange,    // live tuning (docs/live-tuning.md): requests and the changes the services applied
+  CommandVerdict,  // the stack's answer to each command, push and live change (with its reason as text)
 };
-constexpr std::size_t kNumTopics = 9;
+constexpr std::size_t kNumTopics = 10;
 const char* topicName(Topic t);
 bool parseTopic(const std::string& name, Topic* out);
 // Topics whose messages carry tick and stamp_ns (the others are events, stamped on arrival).
-inline bool hasTick(Topic t) { return t <= Topic::WbcDiagnostics; }
+constexpr bool hasTick(Topic t) { return t <= Topic::WbcDiagnostics; }
 
 // Variant index == Topic value.
 using Message = std::variant<msg::GroundTruth, msg::SensorData, msg::RobotState, msg::Reference, msg::JointCommand,
-                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance, msg::ConfigChange>;
+                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance, msg::ConfigChange,
+                             msg::CommandVerdict>;
 inline Topic topicOf(const Message& m) { return static_cast<Topic>(m.index()); }
+Message emptyMessage(Topic t);  // a default-constructed message of the topic
 // tick (or seq for events) and stamp_ns of a message (0 for events).
 std::uint64_t tickOf(const Message& m);
 std::uint64_t stampOf(const Message& m);
@@ -57,9 +63,11 @@ struct LabelSpec {
   LabelClass cls;
   std::vector<std::string> columns;  // RawDAQ: AIN_double channels; IMU: the exported fields
   std::vector<std::string> units;
+  std::vector<std::string> exact;    // schema 2: the 64-bit integer channels also held exactly in AIN_32bits
+  std::vector<std::pair<std::string, std::size_t>> text;  // schema 2: text fields (name, bytes) in AIN_8bits
   std::string description;
 };
-// Every label of schema 1, in writing order (the labels of one topic are contiguous).
+// Every label, in writing order (the labels of one topic are contiguous).
 const std::vector<LabelSpec>& labels();
 int labelIndex(const std::string& label);  // -1 if unknown
 // The label indices of one topic, in writing order.
@@ -104,7 +112,11 @@ class MessageAssembler {
 };
 
 // Values of one observation as named columns (the CSV export): RawDAQ channels, or the IMU fields of the label.
+// A 64-bit integer channel is a double here (exact below 2^53); observationCells() writes it exactly.
 bool observationValues(const mrpt::obs::CObservation& obs, int label_index, std::vector<double>* values);
+// The CSV cells of one observation, each preceded by a comma: the columns (integers exactly when the file holds
+// them exactly, doubles at full precision), then the text fields quoted. False if it does not fit the label.
+bool observationCells(const mrpt::obs::CObservation& obs, int label_index, std::string* cells);
 
 // ---- metadata ----
 struct Metadata {

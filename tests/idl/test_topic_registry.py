@@ -15,14 +15,15 @@ from mftstack import topics  # noqa: E402
 from mftstack.paths import REPO  # noqa: E402
 
 GEN = REPO / "idl" / "gen_topics.py"
-# scripts/make-security.sh's hand-written PUB/SUB tables, as they were when the registry replaced them.
+# scripts/make-security.sh's hand-written PUB/SUB tables, as they were when the registry replaced them, and since
+# then the recorder reading CommandVerdict (recorded from rawlog schema 2 on).
 PERMISSIONS_BEFORE = {
     "sim": ("SensorData GroundTruth CommandVerdict", "JointCommand Disturbance RecorderProgress"),
     "estimator": ("RobotState", "SensorData GroundTruth"),
     "planner": ("Reference CommandVerdict ConfigChange", "RobotState OperatorCommand ConfigChange"),
     "wbc": ("JointCommand WbcDiagnostics CommandVerdict ConfigChange", "RobotState Reference ConfigChange"),
     "record": ("RecorderProgress", "SensorData GroundTruth RobotState OperatorCommand Reference JointCommand "
-                                   "WbcDiagnostics Disturbance ConfigChange"),
+                                   "WbcDiagnostics Disturbance ConfigChange CommandVerdict"),
     "cmd": ("OperatorCommand Disturbance ConfigChange", "CommandVerdict"),
 }
 

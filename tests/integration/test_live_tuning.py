@@ -101,7 +101,7 @@ class LiveTuningInLockstep(unittest.TestCase):
             cls.no_at, cls.passed = no_at.result(), passed.result()
         code, cls.tuned_summary, err = cls.stacks.finish(proc, timeout=600)
         assert code == 0, f"tuned run: exit {code}: {err[-3000:]}"
-        labels = ["gt_q", "joint_tau_cmd", "config_change"]
+        labels = ["gt_q", "joint_tau_cmd", "config_change", "command_verdict"]
         cls.a = export(cls.plain, tmp / "plain-csv", labels)
         cls.b = export(cls.tuned, tmp / "tuned-csv", labels)
 
@@ -190,6 +190,23 @@ class LiveTuningInLockstep(unittest.TestCase):
         print(f"\nreplay --through-wbc: {r['ticks_compared']} ticks, max |dtau| {r['max_abs_diff_Nm']:.3g} N m with the "
               f"recorded change; {r2['max_abs_diff_Nm']:.3g} N m without it (first at tick "
               f"{r2['first_differing_tick']})", file=sys.stderr)
+
+    def test_7_the_recording_holds_the_verdicts_with_their_reasons(self):
+        # The WBC's answers (source 2): the change scheduled then applied, and the two refusals, each with the
+        # reason mft-cmd printed, exactly as text, and the seq of its request.
+        rows = [r for r in self.b["command_verdict"] if int(r["source"]) == 2]
+        change = self.set_result[1]["changes"][0]
+        applied = [r for r in rows if int(r["verdict"]) == 2]
+        self.assertEqual(len(applied), 1, rows)
+        self.assertEqual(applied[0]["reason"], change["verdicts"][-1]["reason"])
+        self.assertEqual(int(applied[0]["tick"]), change["verdicts"][-1]["tick"])
+        self.assertEqual([int(r["verdict"]) for r in rows if r["seq"] == applied[0]["seq"]], [1, 2], rows)
+        rejected = [r for r in rows if int(r["verdict"]) == 0]
+        self.assertEqual(len(rejected), 2, rows)
+        reasons = " | ".join(r["reason"] for r in rejected)
+        self.assertIn("a lockstep stack takes a change at a stated simulated time only (mft-cmd --at T)", reasons)
+        self.assertRegex(reasons, r"t = 0\.500 s has passed")
+        self.assertEqual(self.a["command_verdict"], [])  # the plain run was asked nothing
 
 
 class LiveTuningInRealtime(StackUpTestCase):

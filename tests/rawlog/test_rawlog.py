@@ -75,7 +75,7 @@ class RecordedLockstepRun(unittest.TestCase):
         code, info, err = self.info(self.rawlog)
         self.assertEqual(code, 0, err)
         self.assertEqual(info["end"], "complete")
-        self.assertEqual(info["schema_version"], 1)
+        self.assertEqual(info["schema_version"], 2)
         for label in TICK_LABELS:
             lab = info["labels"][label]
             self.assertEqual(lab["count"], 10000, label)
@@ -193,7 +193,7 @@ class RecordedLockstepRun(unittest.TestCase):
         foreign_gz.write_bytes(gzip.compress(b"\x00\x01\x02 binary junk" * 100))
         schema = self.tmp.path / "schema9.rawlog"
         raw = gzip.decompress(data)
-        i = raw.find(b"schema_version: 1\n")
+        i = raw.find(b"schema_version: 2\n")
         self.assertGreater(i, 0)
         schema.write_bytes(gzip.compress(raw[:i] + b"schema_version: 9\n" + raw[i + 18:], compresslevel=1))
         for f, why in ((text, "not an MRPT rawlog"), (foreign_gz, "not an MRPT rawlog"),

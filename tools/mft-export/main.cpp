@@ -111,10 +111,11 @@ int exportMain(int argc, char** argv) {
   std::uint64_t unknown = 0;
   mrpt::obs::CObservation::Ptr obs;
   std::vector<double> values;
+  std::string cells;
   std::int64_t last_unix_ns = 0, first_unix_ns = -1;
   while (reader->next(&obs)) {
     const int li = rawlog::labelIndex(obs->sensorLabel);
-    if (li < 0 || !rawlog::observationValues(*obs, li, &values)) {
+    if (li < 0 || !rawlog::observationValues(*obs, li, &values) || !rawlog::observationCells(*obs, li, &cells)) {
       ++unknown;
       continue;
     }
@@ -144,10 +145,11 @@ int exportMain(int argc, char** argv) {
         }
         std::fputs("stamp_ns,time_s", in.csv);
         for (const auto& c : spec.columns) std::fprintf(in.csv, ",%s", c.c_str());
+        for (const auto& t : spec.text) std::fprintf(in.csv, ",%s", t.first.c_str());
         std::fputc('\n', in.csv);
       }
       std::fprintf(in.csv, "%lld,%.9f", static_cast<long long>(stamp), static_cast<double>(stamp) * 1e-9);
-      for (double v : values) std::fprintf(in.csv, ",%.17g", v);
+      std::fputs(cells.c_str(), in.csv);  // integers exact, text quoted
       std::fputc('\n', in.csv);
     }
   }

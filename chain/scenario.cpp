@@ -32,6 +32,7 @@ std::string oneOf(StrictNode& n, const std::string& key, std::initializer_list<c
 }
 
 Scenario read(StrictNode& root) {
+  root.useSchema("scenario");  // every number it reads is checked against its range (config_schema.hpp)
   Scenario s;
   s.source_file = root.file();
   const int version = root.integer("schema_version");

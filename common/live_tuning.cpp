@@ -2,10 +2,12 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
+#include "common/config_schema.hpp"
 #include "common/strict_yaml.hpp"
 
 namespace mft::config {
@@ -95,6 +97,8 @@ std::string setKey(const std::string& yaml_text, const std::string& dotted_key, 
   } catch (const YAML::Exception& e) {
     throw ConfigError(origin + ": " + dotted_key + ": the value '" + value_yaml + "' is not YAML: " + e.what());
   }
+  // A quoted value is text: keep it text in the emitted file (the emitter would write "5" as a plain 5).
+  if (value.IsScalar() && value.Tag() == "!") value.SetTag("tag:yaml.org,2002:str");
   const auto parts = splitKey(dotted_key);
   if (parts.empty()) throw ConfigError(origin + ": an empty key");
   for (const auto& p : parts)
@@ -145,6 +149,45 @@ std::string formatNumbers(const double* values, std::size_t count) {
   std::string out = "[";
   for (std::size_t i = 0; i < count; ++i) out += (i ? ", " : "") + one(values[i]);
   return out + "]";
+}
+
+namespace {
+// The numbers of a plain YAML number or list of numbers; false for anything else (text, tags, mappings).
+bool plainNumbers(const YAML::Node& n, std::vector<double>* out) {
+  auto one = [out](const YAML::Node& x) {
+    if (!x.IsScalar() || x.Tag() != "?") return false;
+    char* end = nullptr;
+    const std::string& s = x.Scalar();
+    const double v = std::strtod(s.c_str(), &end);
+    if (s.empty() || *end != '\0') return false;
+    out->push_back(v);
+    return true;
+  };
+  if (n.IsScalar()) return one(n);
+  if (!n.IsSequence() || n.size() == 0) return false;
+  for (const auto& x : n)
+    if (!one(x)) return false;
+  return true;
+}
+}  // namespace
+
+void checkLiveValue(const std::string& stem, const std::string& key, const std::string& value_yaml,
+                    const std::string& origin) {
+  const KeyRange* range = findKeyRange(stem, key);
+  if (!range) return;
+  YAML::Node value;
+  try {
+    value = YAML::Load(value_yaml);
+  } catch (const YAML::Exception&) {
+    throw ConfigError(origin + ": " + key + ": the value '" + value_yaml + "' is not YAML");
+  }
+  std::vector<double> numbers;
+  if (!plainNumbers(value, &numbers))
+    throw ConfigError(origin + ": " + key + ": expected a number or a list of numbers, got '" + value_yaml + "'");
+  for (double v : numbers) {
+    const std::string why = std::isfinite(v) ? rangeViolation(*range, v) : "must be finite";
+    if (!why.empty()) throw ConfigError(origin + ": " + key + ": " + why);
+  }
 }
 
 void requireTunable(const std::string& stem, const std::string& key, const std::string& origin) {

@@ -42,6 +42,11 @@ struct ConfigOverride {
   std::vector<double> value;     // the new value as loaded (1 or 2 numbers)
   std::vector<double> previous;  // the value before the change
 };
+// The first check of a live change before it is sent (mft-cmd --set): a value for a key with a range in the
+// configuration schema (config_schema.hpp) must be plain numbers inside that range ("!!str 5" and "1e308" are
+// refused). Anything else is left to the answering service's loader. Throws ConfigError naming `origin`.
+void checkLiveValue(const std::string& stem, const std::string& key, const std::string& value_yaml,
+                    const std::string& origin);
 // Refuses a `key` of file `stem` that is not tunable live (ConfigError naming the tunable keys).
 void requireTunable(const std::string& stem, const std::string& key, const std::string& origin);
 // Sets `key` to `value_yaml` in `yaml_text` (named `origin` in messages), reads the result with `load(text,

@@ -1,5 +1,6 @@
 #include "common/strict_yaml.hpp"
 
+#include "common/config_schema.hpp"
 #include "common/profiles.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <type_traits>
 
 namespace mft::config {
 
@@ -17,6 +19,9 @@ struct StrictNode::Impl {
   std::string path;  // dotted key path of this mapping, "" at the root
   std::set<std::string> used;
   std::map<std::string, std::unique_ptr<StrictNode>> children;
+  std::string schema;         // configSchema() stem, "" = not checked
+  std::string schema_prefix;  // path of this node in the schema's key names
+  std::vector<std::pair<std::string, std::vector<double>>> numbers_read;  // key -> values, checked in finish()
 };
 
 namespace {
@@ -94,9 +99,19 @@ YAML::Node StrictNode::take(const std::string& key, Shape shape, const std::stri
   return n;
 }
 
+namespace {
+// A number must be a plain scalar: `!!str 5` or "5" is text, which yaml-cpp would otherwise convert.
+bool plainOrNumericTag(const YAML::Node& n) {
+  const std::string& tag = n.Tag();
+  return tag == "?" || tag == "tag:yaml.org,2002:int" || tag == "tag:yaml.org,2002:float";
+}
+}  // namespace
+
 template <class T>
 T StrictNode::scalar(const std::string& key, const std::string& expected) {
   const YAML::Node n = take(key, Shape::Scalar, expected);
+  if (!std::is_same<T, bool>::value && !plainOrNumericTag(n))
+    fail(key, expected + ", got the text '" + n.Scalar() + "'");
   try {
     return n.as<T>();
   } catch (const YAML::Exception&) {
@@ -109,6 +124,8 @@ StrictNode& StrictNode::addChild(const std::string& name, const YAML::Node& node
   impl->node = node;
   impl->file = impl_->file;
   impl->path = join(impl_->path, name);
+  impl->schema = impl_->schema;
+  impl->schema_prefix = impl_->schema_prefix;
   auto& slot = impl_->children[name];
   slot.reset(new StrictNode(std::move(impl)));
   return *slot;
@@ -135,6 +152,7 @@ StrictNode& StrictNode::item(const std::string& key, std::size_t index) {
 double StrictNode::number(const std::string& key) {
   const double v = scalar<double>(key, "expected a number");
   if (!std::isfinite(v)) fail(key, "must be finite");
+  noteNumbers(key, {v});
   return v;
 }
 
@@ -176,7 +194,11 @@ std::vector<double> StrictNode::numbersInRange(const std::string& key, std::size
   return v;
 }
 
-int StrictNode::integer(const std::string& key) { return scalar<int>(key, "expected an integer"); }
+int StrictNode::integer(const std::string& key) {
+  const int v = scalar<int>(key, "expected an integer");
+  if (!(impl_->path.empty() && key == "schema_version")) noteNumbers(key, {static_cast<double>(v)});
+  return v;
+}
 
 bool StrictNode::boolean(const std::string& key) { return scalar<bool>(key, "expected true or false"); }
 
@@ -216,6 +238,7 @@ std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expe
   out.reserve(n.size());
   for (std::size_t i = 0; i < n.size(); ++i) {
     double v = 0.0;
+    if (!n[i].IsScalar() || !plainOrNumericTag(n[i])) fail(key, "element " + std::to_string(i) + " is not a number");
     try {
       v = n[i].as<double>();
     } catch (const YAML::Exception&) {
@@ -224,6 +247,7 @@ std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expe
     if (!std::isfinite(v)) fail(key, "element " + std::to_string(i) + " must be finite");
     out.push_back(v);
   }
+  noteNumbers(key, out);
   return out;
 }
 
@@ -249,6 +273,28 @@ void StrictNode::finish() {
     throw ConfigError(impl_->file + ": unknown key" + (unknown.size() > 1 ? "s " : " ") + list);
   }
   for (auto& c : impl_->children) c.second->finish();
+  checkSchema();
+}
+
+void StrictNode::useSchema(const std::string& stem, const std::string& prefix) {
+  impl_->schema = stem;
+  impl_->schema_prefix = prefix;
+}
+
+void StrictNode::noteNumbers(const std::string& key, std::vector<double> values) {
+  if (!impl_->schema.empty()) impl_->numbers_read.emplace_back(key, std::move(values));
+}
+
+void StrictNode::checkSchema() const {
+  for (const auto& [key, values] : impl_->numbers_read) {
+    const std::string name = join(impl_->schema_prefix, join(impl_->path, key));
+    const KeyRange* range = findKeyRange(impl_->schema, name);
+    if (!range) fail(key, "no range in the configuration schema for " + impl_->schema + " key " + name);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const std::string why = rangeViolation(*range, values[i]);
+      if (!why.empty()) fail(key, (values.size() > 1 ? "element " + std::to_string(i) + " " : "") + why);
+    }
+  }
 }
 
 }  // namespace mft::config

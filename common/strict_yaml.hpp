@@ -95,7 +95,13 @@ class StrictNode {
   // Returns the list of keys of this mapping, marking none as used.
   std::vector<std::string> keys() const;
 
-  // Throws ConfigError naming every key of this mapping (and of its children) that was never read.
+  // Checks every number read from this mapping and its children against the range of configSchema()
+  // (config_schema.hpp) for `stem` when finished: a number outside its range, or one the schema does not
+  // list, is a ConfigError. Keys are named `prefix`.key (a node read apart from its file, e.g. a list entry).
+  void useSchema(const std::string& stem, const std::string& prefix = "");
+
+  // Throws ConfigError naming every key of this mapping (and of its children) that was never read, then
+  // checks the numbers read against the schema (useSchema).
   void finish();
 
   // "file: key.path: message" for errors found by the caller after reading (e.g. cross-field checks).
@@ -114,6 +120,8 @@ class StrictNode {
   // Keeps the child mapping `name` (a key, or key[i] of a list) over `node`; finished with this node.
   StrictNode& addChild(const std::string& name, const YAML::Node& node);
   std::array<double, 2> orderedNumberPair(const std::string& key, bool allow_equal);
+  void noteNumbers(const std::string& key, std::vector<double> values);
+  void checkSchema() const;
   explicit StrictNode(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };

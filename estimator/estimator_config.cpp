@@ -16,6 +16,7 @@ constexpr EnumName<ContactSource> kContactSourceNames[] = {{ContactSource::Switc
                                                            {ContactSource::Both, "both"}};
 
 EstimatorConfig read(StrictNode& root) {
+  root.useSchema("estimator");  // every number it reads is checked against its range (config_schema.hpp)
   EstimatorConfig c;
   c.mode = root.choice("mode", kModeNames);
 

@@ -67,6 +67,7 @@ Eigen::RowVectorXd flatRow(const std::vector<double>& v, int k, int cols) {
 }
 
 MftPolytope read(StrictNode& root, const RobotDescription& robot) {
+  root.useSchema("mft_space");  // every number it reads is checked against its range (config_schema.hpp)
   MftPolytope p;
 
   auto& rob = root.child("robot");

@@ -67,6 +67,7 @@ std::uint64_t computeChecksum(const RobotDescription& d) {
 }
 
 RobotDescription read(StrictNode& root) {
+  root.useSchema("robot");  // every number it reads is checked against its range (config_schema.hpp)
   RobotDescription d;
   d.name = root.text("name");
   d.gravity_mps2 = root.inRange("gravity_mps2", 1.0, 30.0, "m/s^2");

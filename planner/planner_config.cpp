@@ -14,6 +14,7 @@ constexpr EnumName<LocomotionMode> kModeNames[] = {{LocomotionMode::Stand, "stan
                                                    {LocomotionMode::Walk, "walk"}};
 
 PlannerConfig read(StrictNode& root) {
+  root.useSchema("planner");  // every number it reads is checked against its range (config_schema.hpp)
   PlannerConfig c;
 
   auto& gait = root.child("gait");

@@ -15,6 +15,7 @@ constexpr EnumName<ActuatorModel> kActuatorModelNames[] = {{ActuatorModel::Sea, 
                                                            {ActuatorModel::Ideal, "ideal"}};
 
 SimOptions read(StrictNode& root) {
+  root.useSchema("sim");  // every number it reads is checked against its range (config_schema.hpp)
   SimOptions o;
   o.control_period_s = root.inRange("control_period_s", 1e-6, 0.1);
   o.substeps = root.integerInRange("substeps", 1, 100);

@@ -66,6 +66,7 @@ Terrain read(const YAML::Node& root, const std::string& origin) {
   Terrain t;
   t.source_file = origin;
   auto head = strictFromYaml(top, origin);
+  head.useSchema("terrain");
   head.expectSchemaVersion(1);
   t.start_x = head.number("start_x_m");
   t.start_height = head.number("start_height_m");
@@ -74,6 +75,7 @@ Terrain read(const YAML::Node& root, const std::string& origin) {
   for (std::size_t i = 0; i < list.size(); ++i) {
     if (!list[i].IsMap()) throw ConfigError(origin + ": terrain[" + std::to_string(i) + "]: expected a mapping");
     auto seg = strictFromYaml(list[i], origin + ": terrain[" + std::to_string(i) + "]");
+    seg.useSchema("terrain", "terrain[]");
     t.segments.push_back(readSegment(seg, x, z));
     x = t.segments.back().x1();
     z = t.segments.back().endLevel();

@@ -29,6 +29,7 @@ constexpr config::EnumName<WbcVariant> kVariantNames[] = {
     {WbcVariant::Mft, "mft"}, {WbcVariant::Sa, "sa"}, {WbcVariant::None, "none"}};
 
 WbcConfig read(StrictNode& root) {
+  root.useSchema("wbc");  // every number it reads is checked against its range (config_schema.hpp)
   WbcConfig c;
   const std::string variant = root.text("variant");
   if (!parseVariant(variant, &c.variant))

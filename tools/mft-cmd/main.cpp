@@ -21,6 +21,8 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "common/live_tuning.hpp"
+#include "common/strict_yaml.hpp"
 #include "common/tool_io.hpp"
 
 using namespace mft;
@@ -107,6 +109,11 @@ static int runSet(const services::CommandLine& cli) {
     if (c.key.size() >= c.msg.key().size() || c.value.size() >= c.msg.value().size())
       cli.fail("--set '" + item + "': key and value must be shorter than 64 characters each");
     if (changes.size() >= 16) cli.fail("--set: at most 16 changes at once");
+    try {
+      config::checkLiveValue(c.file, c.key, c.value, "--set '" + item + "'");
+    } catch (const config::ConfigError& e) {
+      cli.fail(e.what());
+    }
     c.msg.seq(base_seq + changes.size());
     std::snprintf(c.msg.key().data(), c.msg.key().size(), "%s", c.key.c_str());
     std::snprintf(c.msg.value().data(), c.msg.value().size(), "%s", c.value.c_str());

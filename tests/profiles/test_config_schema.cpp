@@ -1,0 +1,133 @@
+// The configuration schema (common/config_schema.hpp): every numeric key of every shipped file has a physical
+// range that the loaders, live tuning and mft-cmd --set enforce, text is not a number, and the reference
+// table in docs/config-reference.md is the schema's.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "chain/scenario.hpp"
+#include "common/config_schema.hpp"
+#include "common/live_tuning.hpp"
+#include "common/strict_yaml.hpp"
+#include "planner/planner_config.hpp"
+#include "planner/planner_tuning.hpp"
+#include "sim/terrain.hpp"
+#include "tools/closedloop/closed_loop.hpp"
+
+namespace mft {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string plannerText() { return readFile(fs::path(MFT_CONFIG_DIR) / "planner.yaml"); }
+
+std::string overrideError(const std::string& key, const std::string& value) {
+  try {
+    planner::applyPlannerOverride(plannerText(), "planner.yaml (live change)", key, value);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string liveValueError(const std::string& stem, const std::string& key, const std::string& value) {
+  try {
+    config::checkLiveValue(stem, key, value, "--set");
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Every shipped file, alone and under every shipped profile, reads without a range error; a key the schema
+// does not list would fail here ("no range in the configuration schema").
+TEST(ConfigSchema, ShippedFilesAndProfilesPass) {
+  const std::string dir = MFT_CONFIG_DIR;
+  EXPECT_NO_THROW(closedloop::loadConfigs(dir, {}));
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "profiles"))
+    EXPECT_NO_THROW(closedloop::loadConfigs(dir, {e.path().stem().string()})) << e.path();
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "scenarios"))
+    EXPECT_NO_THROW(chain::loadScenario(e.path().string())) << e.path();
+  for (const auto& e : fs::directory_iterator(fs::path(dir) / "terrain"))
+    EXPECT_NO_THROW(sim::loadTerrain(e.path().string())) << e.path();
+}
+
+TEST(ConfigSchema, NonPhysicalPlannerValuesRefusedByTheLoader) {
+  std::string text = plannerText();
+  text.replace(text.find("lift_height_m: 0.06"), 19, "lift_height_m: 50");
+  try {
+    planner::parsePlannerConfig(text, "planner.yaml");
+    FAIL() << "lift_height_m 50 accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("swing.lift_height_m: must lie in [0, 0.3] m (got 50)"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ConfigSchema, NonPhysicalValuesRefusedByLiveTuning) {
+  EXPECT_NE(overrideError("swing.lift_height_m", "50").find("must lie in [0, 0.3] m (got 50)"), std::string::npos);
+  EXPECT_NE(overrideError("foot_placement.k_v", "1e308").find("must lie in [0, 2] s (got 1e+308)"), std::string::npos);
+  EXPECT_EQ(overrideError("foot_placement.k_v", "0.145"), "");
+}
+
+TEST(ConfigSchema, TextIsNotANumber) {
+  EXPECT_NE(overrideError("foot_placement.k_v", "!!str 0.1").find("expected a number, got the text '0.1'"),
+            std::string::npos);
+  EXPECT_NE(overrideError("foot_placement.k_v", "\"0.1\"").find("expected a number"), std::string::npos);
+  std::string text = plannerText();
+  text.replace(text.find("height_window_m: [0.30, 0.46]"), 29, "height_window_m: [0.30, !!str 0.46]");
+  EXPECT_THROW(planner::parsePlannerConfig(text, "planner.yaml"), config::ConfigError);
+  text = plannerText();
+  text.replace(text.find("k_p: 0.08"), 9, "k_p: \"0.08\"");
+  EXPECT_THROW(planner::parsePlannerConfig(text, "planner.yaml"), config::ConfigError);
+}
+
+// mft-cmd --set checks the value before it is sent.
+TEST(ConfigSchema, LiveValueCheckOfMftCmd) {
+  EXPECT_NE(liveValueError("planner", "swing.lift_height_m", "50").find("must lie in [0, 0.3] m"), std::string::npos);
+  EXPECT_NE(liveValueError("planner", "foot_placement.k_v", "1e308").find("must lie in [0, 2] s"), std::string::npos);
+  EXPECT_NE(liveValueError("planner", "foot_placement.k_v", "1e999").find("must be finite"), std::string::npos);
+  EXPECT_NE(liveValueError("planner", "foot_placement.k_v", "!!str 5").find("expected a number"), std::string::npos);
+  EXPECT_NE(liveValueError("wbc", "gains.swing_foot.kp", "[300, 1e9]").find("must lie in"), std::string::npos);
+  EXPECT_EQ(liveValueError("wbc", "gains.swing_foot.kp", "[300, 300]"), "");
+  EXPECT_EQ(liveValueError("wbc", "variant", "sa"), "");  // not numeric: left to the service
+}
+
+TEST(ConfigSchema, ListEntriesUseTheirListRange) {
+  const auto* r = config::findKeyRange("scenario", "commands[12].v_cmd_mps");
+  ASSERT_NE(r, nullptr);
+  EXPECT_DOUBLE_EQ(r->hi, 3.0);
+  EXPECT_EQ(config::findKeyRange("planner", "swing.no_such_key"), nullptr);
+}
+
+// docs/config-reference.md holds the generated table between two markers; MFT_UPDATE_SCHEMA_DOC=1 rewrites it.
+TEST(ConfigSchema, DocsTableIsTheSchema) {
+  const fs::path path = fs::path(MFT_CONFIG_DIR) / ".." / "docs" / "config-reference.md";
+  std::string doc = readFile(path);
+  const std::string begin = "<!-- schema begin -->\n", end = "<!-- schema end -->";
+  const auto b = doc.find(begin), e = doc.find(end);
+  ASSERT_NE(b, std::string::npos);
+  ASSERT_NE(e, std::string::npos);
+  const std::string table = doc.substr(b + begin.size(), e - b - begin.size());
+  if (std::getenv("MFT_UPDATE_SCHEMA_DOC") && table != config::schemaMarkdown()) {
+    doc.replace(b + begin.size(), table.size(), config::schemaMarkdown());
+    std::ofstream(path) << doc;
+    return;
+  }
+  EXPECT_EQ(table, config::schemaMarkdown()) << "regenerate: MFT_UPDATE_SCHEMA_DOC=1 build/release/tests/profiles/test_profiles "
+                                                "--gtest_filter=ConfigSchema.DocsTableIsTheSchema";
+}
+
+}  // namespace
+}  // namespace mft

@@ -35,11 +35,11 @@ SECURE_RUN_ATTEMPTS = 2
 DISCOVERY_SERVER_READY = "### Server is running ###"
 
 
-def _set_pdeathsig():
+def _set_pdeathsig(sig=signal.SIGKILL):
     # Runs in the child between fork and exec: die with the supervisor, whatever killed it.
     libc = ctypes.CDLL("libc.so.6", use_errno=True)
     PR_SET_PDEATHSIG = 1
-    libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    libc.prctl(PR_SET_PDEATHSIG, sig)
 
 
 def chain_cpu_for(chain_cpu, mode, domain, multi_host):
@@ -71,12 +71,69 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
     return cpu
 
 
+CHAIN_SEGMENT_BYTES = 3_300_000  # a little more than the chain channel's segment (ChainChannel::segmentBytes)
+CHAIN_SEGMENT = re.compile(r"^mft-chain-d\d+-(\d+)-\d+$")
+
+
+def remove_orphan_segments(shm_dir="/dev/shm"):
+    """Removes chain segments whose supervisor (the pid in the name) is gone: a supervisor killed with SIGKILL
+    cannot remove its own. Returns the names removed."""
+    removed = []
+    try:
+        names = os.listdir(shm_dir)
+    except OSError:
+        return removed
+    for name in names:
+        m = CHAIN_SEGMENT.match(name)
+        if not m or _pid_alive(int(m.group(1))):
+            continue
+        try:
+            os.unlink(os.path.join(shm_dir, name))
+            removed.append(name)
+        except OSError:
+            pass
+    return removed
+
+
+def _pid_alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:
+        return True
+    return True
+
+
+def shm_problem(shm_dir="/dev/shm"):
+    """Why the chain's segment cannot go in /dev/shm, or None."""
+    if not os.access(shm_dir, os.W_OK):
+        return f"{shm_dir} is not writable"
+    try:
+        st = os.statvfs(shm_dir)
+    except OSError as e:
+        return f"{shm_dir}: {e.strerror}"
+    free = st.f_bavail * st.f_frsize
+    if free < CHAIN_SEGMENT_BYTES:
+        return f"{shm_dir} has {free / 1e6:.1f} MB free, the chain's segment needs {CHAIN_SEGMENT_BYTES / 1e6:.1f} MB"
+    return None
+
+
 def chain_shm_name(args, multi_host):
     """The shared-memory segment of this stack's chain channel, or None: --chain-transport, by default shm in both
-    modes; never with --secure (it would bypass access control) or --stack (several hosts), nor on a machine without
-    a writable /dev/shm (some containers)."""
-    transport = getattr(args, "chain_transport", None) or "shm"
-    if transport != "shm" or multi_host or getattr(args, "secure", None) or not os.access("/dev/shm", os.W_OK):
+    modes; never with --secure (it would bypass access control) or --stack (several hosts). By default a /dev/shm
+    that is not writable or too full for the segment means DDS (some containers), with a note; an explicit
+    --chain-transport shm is then an error."""
+    explicit = getattr(args, "chain_transport", None)
+    if (explicit or "shm") != "shm" or multi_host or getattr(args, "secure", None):
+        return None
+    for name in remove_orphan_segments():
+        log(f"removed /dev/shm/{name}: its supervisor is gone")
+    problem = shm_problem()
+    if problem and explicit:
+        raise SupervisorError(f"--chain-transport shm: {problem}")
+    if problem:
+        log(f"chain transport: dds ({problem})")
         return None
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
@@ -140,9 +197,12 @@ class Service:
         logf = open_service_log(self)
         extra = ["--summary", str(self.summary_path)] if self.summary_path else []
         cpus = self.cpus
+        # The recorder gets SIGTERM, so that it closes its file (gzip end, sidecar status) when the supervisor
+        # is killed; the others SIGKILL.
+        death_signal = signal.SIGTERM if self.name == "mft-record" else signal.SIGKILL
 
         def before_exec():
-            _set_pdeathsig()
+            _set_pdeathsig(death_signal)
             if cpus:
                 os.sched_setaffinity(0, cpus)
 

@@ -8,7 +8,11 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <signal.h>
+
 #include <cerrno>
+#include <cstdio>
+#include <thread>
 #include <climits>
 #include <cstring>
 
@@ -16,7 +20,6 @@ namespace mft::services {
 
 namespace {
 
-constexpr std::size_t kSegmentBytes = sizeof(ChainChannel::Slot) * ChainChannel::kSlots;
 static_assert(std::atomic<std::uint32_t>::is_always_lock_free && sizeof(std::atomic<std::uint32_t>) == 4,
               "the futex word must be a plain 32-bit integer");
 
@@ -39,26 +42,96 @@ int chainSlotIndex(const std::string& topic_name) {
   return row < 0 ? -1 : msg::kTopics[static_cast<std::size_t>(row)].chain_slot;
 }
 
+std::size_t ChainChannel::segmentBytes() { return kHeaderBytes + sizeof(Slot) * kSlots; }
+
+namespace {
+void* mapSegment(int fd) {
+  void* memory = mmap(nullptr, ChainChannel::segmentBytes(), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  return memory == MAP_FAILED ? nullptr : memory;
+}
+bool processAlive(std::int64_t pid) { return pid > 0 && (kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM); }
+std::string megabytes(std::size_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f MB", static_cast<double>(bytes) / 1e6);
+  return buf;
+}
+}  // namespace
+
 ChainChannel::ChainChannel(const std::string& name) : name_(name) {
+  static_assert(sizeof(Header) <= kHeaderBytes && kHeaderBytes % alignof(Slot) == 0, "header layout");
   if (name.size() < 2 || name[0] != '/' || name.find('/', 1) != std::string::npos || name.size() > 200)
     throw ChainChannelError("--chain-shm " + name + ": expected a name like /mft-chain-NAME (one leading slash)");
-  const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT, 0600);
+  int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
+  const bool creator = fd >= 0;
+  if (!creator && errno == EEXIST) fd = shm_open(name.c_str(), O_RDWR, 0600);
   if (fd < 0) throw ChainChannelError(errnoText("cannot open the shared-memory segment", name));
-  // Every process sizes it: growing a fresh (empty) segment zeroes it; the same size again changes nothing.
-  struct stat st {};
-  if (fstat(fd, &st) != 0 || (static_cast<std::size_t>(st.st_size) != kSegmentBytes && ftruncate(fd, kSegmentBytes) != 0)) {
-    const std::string error = errnoText("cannot size the shared-memory segment", name);
+  try {
+    memory_ = creator ? create(fd) : attach(fd);
+  } catch (...) {
     close(fd);
-    throw ChainChannelError(error);
+    throw;
   }
-  void* memory = mmap(nullptr, kSegmentBytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   close(fd);
-  if (memory == MAP_FAILED) throw ChainChannelError(errnoText("cannot map the shared-memory segment", name));
-  slots_ = static_cast<Slot*>(memory);
+  slots_ = reinterpret_cast<Slot*>(static_cast<unsigned char*>(memory_) + kHeaderBytes);
+}
+
+void* ChainChannel::create(int fd) {
+  const std::size_t bytes = segmentBytes();
+  // Reserve every page now: on a full /dev/shm a mapping that was only truncated faults (SIGBUS) at a write.
+  const int err = ftruncate(fd, static_cast<off_t>(bytes)) != 0 ? errno : posix_fallocate(fd, 0, static_cast<off_t>(bytes));
+  void* memory = err == 0 ? mapSegment(fd) : nullptr;
+  if (!memory) {
+    const int why = err ? err : errno;
+    shm_unlink(name_.c_str());
+    throw ChainChannelError("cannot reserve " + megabytes(bytes) + " for the shared-memory segment " + name_ +
+                            " in /dev/shm: " + std::strerror(why) +
+                            (why == ENOSPC ? " (free space in /dev/shm, or run with --chain-transport dds)" : ""));
+  }
+  auto* header = static_cast<Header*>(memory);
+  header->version = kVersion;
+  header->bytes = bytes;
+  header->creator_pid = getpid();
+  header->stack_pid = getppid();
+  header->magic.store(kMagic, std::memory_order_release);
+  return memory;
+}
+
+void* ChainChannel::attach(int fd) {
+  const std::string refuse = "the shared-memory segment " + name_ + " (/dev/shm" + name_ + ") ";
+  const std::string remedy = ": not this stack's chain segment (stale or foreign); remove it or choose another name";
+  struct stat st {};
+  if (fstat(fd, &st) != 0) throw ChainChannelError(errnoText("cannot inspect the shared-memory segment", name_));
+  // The creator truncates to the full size, reserves, then writes the header (magic last): an empty segment or
+  // a zero magic may be one being made (waited for, bounded); any other size or magic is not a chain segment.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (st.st_size == 0 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    if (fstat(fd, &st) != 0) throw ChainChannelError(errnoText("cannot inspect the shared-memory segment", name_));
+  }
+  if (static_cast<std::size_t>(st.st_size) != segmentBytes())
+    throw ChainChannelError(refuse + "has " + std::to_string(st.st_size) + " bytes, not " +
+                            std::to_string(segmentBytes()) + remedy);
+  void* memory = mapSegment(fd);
+  if (!memory) throw ChainChannelError(errnoText("cannot map the shared-memory segment", name_));
+  auto* header = static_cast<Header*>(memory);
+  while (header->magic.load(std::memory_order_acquire) == 0 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  std::string wrong;
+  if (header->magic.load(std::memory_order_acquire) != kMagic)
+    wrong = "has no chain header";
+  else if (header->version != kVersion || header->bytes != segmentBytes())
+    wrong = "has layout version " + std::to_string(header->version) + ", not " + std::to_string(kVersion);
+  else if (!processAlive(header->stack_pid) && !processAlive(header->creator_pid))
+    wrong = "was made under process " + std::to_string(header->stack_pid) + ", which is gone";
+  if (!wrong.empty()) {
+    munmap(memory, segmentBytes());
+    throw ChainChannelError(refuse + wrong + remedy);
+  }
+  return memory;
 }
 
 ChainChannel::~ChainChannel() {
-  if (slots_) munmap(slots_, kSegmentBytes);
+  if (memory_) munmap(memory_, segmentBytes());
 }
 
 void ChainChannel::unlinkName() const { shm_unlink(name_.c_str()); }

@@ -70,8 +70,11 @@ class ChainChannel {
   };
 
   // Opens (creating it if needed) the segment `name` ("/mft-chain-…", as shm_open takes it). Every process of
-  // the stack opens the same name; the first one sizes it and the memory starts zeroed. Throws
-  // ChainChannelError with the reason.
+  // the stack opens the same name. The one that creates it reserves all its memory at once (posix_fallocate: a
+  // full /dev/shm is an error here, not a SIGBUS at the first write to a page) and then writes the header; the
+  // others wait (bounded) for the header and check it: a segment of another size, without the header (random
+  // bytes), of another layout version, or made under a stack whose supervisor is gone (a stale copy) is refused.
+  // Throws ChainChannelError with the reason.
   explicit ChainChannel(const std::string& name);
   ~ChainChannel();
   ChainChannel(const ChainChannel&) = delete;
@@ -83,8 +86,25 @@ class ChainChannel {
   void unlinkName() const;
   Slot& slot(int index) { return slots_[index]; }
 
+  // The first bytes of the segment: who made it, for which layout.
+  struct Header {
+    std::atomic<std::uint64_t> magic;  // kMagic once the rest is written (stored last)
+    std::uint32_t version;             // kVersion: the layout of the slots
+    std::uint32_t reserved;
+    std::uint64_t bytes;               // the whole segment
+    std::int64_t creator_pid;
+    std::int64_t stack_pid;            // the creator's parent: the supervisor of the stack
+  };
+  static constexpr std::uint64_t kMagic = 0x314e49414843544dULL;  // "MTCHAIN1"
+  static constexpr std::uint32_t kVersion = 1;
+  static constexpr std::size_t kHeaderBytes = 256;  // the slots start here (a multiple of their alignment)
+  static std::size_t segmentBytes();
+
  private:
+  void* create(int fd);
+  void* attach(int fd);
   std::string name_;
+  void* memory_ = nullptr;
   Slot* slots_ = nullptr;
 };
 

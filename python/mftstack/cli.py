@@ -317,10 +317,24 @@ def cmd_down(args):
     return 0
 
 
+def positive_count(text):
+    """An argparse type: an integer >= 1."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {n}")
+    return n
+
+
 def cmd_logs(args):
     check_domain_range(args.domain)
     st = read_state(args.domain, args.host)
     run_dir = Path(st["run_dir"])
+    if args.service and args.service not in st["services"]:  # a name, never a path out of the run folder
+        raise SupervisorError(f"no service {args.service!r} in the stack on domain {args.domain} "
+                              f"(services: {', '.join(st['services'])})")
     names = [args.service] if args.service else list(st["services"])
     for n in names:
         path = run_dir / f"{n}.log"
@@ -401,7 +415,7 @@ def main(argv=None):
     sp = sub.add_parser("logs", help="print the logs of a running stack")
     sp.add_argument("service", nargs="?", help="one service (default: all)")
     sp.add_argument("--domain", type=int, default=0)
-    sp.add_argument("--lines", type=int, default=0, help="only the last N lines")
+    sp.add_argument("--lines", type=positive_count, default=0, help="only the last N lines (N >= 1)")
     sp.add_argument("--host", metavar="NAME", help="the stack of this host (started with up --host NAME)")
     sp.set_defaults(func=cmd_logs)
 

@@ -255,6 +255,32 @@ class SupervisorTest(FakeStack, unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("no stack is up on domain 11", r.stderr)
 
+    def test_logs_takes_a_service_name_and_a_positive_line_count(self):
+        env = dict(self.env, FAKE_SERVICES="")
+        base = [sys.executable, str(SUPERVISOR)]
+        r = subprocess.run(base + ["up", str(self.scenario), "--domain", "12", "--bin-dir", str(self.bin),
+                                   "--config-dir", str(self.cfg)], env=env, capture_output=True, text=True, timeout=60)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        try:
+            st = json.loads(subprocess.run(base + ["status", "--domain", "12", "--json"], env=env,
+                                           capture_output=True, text=True).stdout)
+            (Path(st["run_dir"]).parent / "secret.log").write_text("SECRET\n")
+            r = subprocess.run(base + ["logs", "../secret", "--domain", "12"], env=env, capture_output=True, text=True)
+            self.assertEqual(r.returncode, 2, r.stdout)
+            self.assertNotIn("SECRET", r.stdout)
+            self.assertIn("no service '../secret' in the stack on domain 12 (services: ", r.stderr)
+            for lines in ("-5", "0", "x"):
+                r = subprocess.run(base + ["logs", "mft-wbc", "--domain", "12", "--lines", lines], env=env,
+                                   capture_output=True, text=True)
+                self.assertEqual(r.returncode, 2, (lines, r.stdout))
+                self.assertIn("--lines: expected a whole number >= 1", r.stderr)
+            r = subprocess.run(base + ["logs", "mft-wbc", "--domain", "12", "--lines", "1"], env=env,
+                               capture_output=True, text=True)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.assertIn("READY mft-wbc", r.stdout)
+        finally:
+            subprocess.run(base + ["down", "--domain", "12"], env=env, capture_output=True, timeout=60)
+
     def test_a_secured_chain_that_never_answers_tick_0_is_started_again(self):
         # Fast DDS 2.9.1's secure handshake can stick on a hop past the simulator's own readers: the simulator's
         # endpoints match, tick 0 never comes back, and it exits 3. `run --secure` starts the stack once more.

@@ -48,6 +48,9 @@ def _numbers(text, noun, valid, why):
     for x in xs:
         if not valid(x):
             raise argparse.ArgumentTypeError(why.format(x))
+    repeated = sorted({x for x in xs if xs.count(x) > 1})
+    if repeated:  # each would run twice and fill the same table cell
+        raise argparse.ArgumentTypeError(f"{noun} {', '.join(f'{x:g}' for x in repeated)} given twice")
     return xs
 
 

@@ -86,32 +86,52 @@ def snapshot_binaries(bin_dir, dest):
             if not (dest / name).is_file() and (Path(bin_dir) / name).is_file():
                 shutil.copy2(Path(bin_dir) / name, dest / name)
     else:
-        tmp = dest.with_name(dest.name + ".tmp")
-        shutil.rmtree(tmp, ignore_errors=True)
-        tmp.mkdir(parents=True)
-        for name in SNAPSHOT:
-            src = Path(bin_dir) / name
-            if not src.is_file():
-                continue
-            for _ in range(10):  # a file being relinked right now: wait until it is stable
-                before = src.stat()
-                shutil.copy2(src, tmp / name)
-                after = src.stat()
-                if (before.st_mtime_ns, before.st_size) == (after.st_mtime_ns, after.st_size) and \
-                        after.st_mtime_ns < time.time_ns() - 2_000_000_000:
-                    break
-                time.sleep(2.0)
-        shutil.copy2(SUPERVISOR, tmp / "mft-supervisor")
-        tmp.rename(dest)
+        _fresh_snapshot(bin_dir, dest)
     # The supervisor's package beside the copied launcher (it looks in ../python first), frozen like the rest.
     package = dest.parent / "python" / "mftstack"
     if not package.is_dir():
         tmp = package.with_name("mftstack.tmp")
-        shutil.rmtree(tmp, ignore_errors=True)
-        shutil.copytree(REPO / "python" / "mftstack", tmp, ignore=shutil.ignore_patterns("__pycache__"))
-        tmp.rename(package)
+        try:
+            shutil.rmtree(tmp, ignore_errors=True)
+            shutil.copytree(REPO / "python" / "mftstack", tmp, ignore=shutil.ignore_patterns("__pycache__"))
+            tmp.rename(package)
+        except OSError as e:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise ExperimentError(f"cannot copy the supervisor's package into {package}: {e.strerror or e}")
     SUPERVISOR = dest / "mft-supervisor"
     return dest
+
+
+def _fresh_snapshot(bin_dir, dest):
+    """Copies the executables into dest.tmp, then renames it to dest. On a write error (a full disk) the partial
+    copy is removed and the error names the folder written, not the file read."""
+    import shutil
+    tmp = dest.with_name(dest.name + ".tmp")
+    try:
+        shutil.rmtree(tmp, ignore_errors=True)
+        tmp.mkdir(parents=True)
+        for name in SNAPSHOT:
+            src = Path(bin_dir) / name
+            if src.is_file():
+                _copy_when_stable(src, tmp / name)
+        shutil.copy2(SUPERVISOR, tmp / "mft-supervisor")
+        tmp.rename(dest)
+    except OSError as e:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise ExperimentError(f"cannot copy the executables into {dest}: {e.strerror or e}"
+                              f"{' (disk full?)' if getattr(e, 'errno', None) == 28 else ''}")
+
+
+def _copy_when_stable(src, dst):
+    import shutil
+    for _ in range(10):  # a file being relinked right now: wait until it is stable
+        before = src.stat()
+        shutil.copy2(src, dst)
+        after = src.stat()
+        if (before.st_mtime_ns, before.st_size) == (after.st_mtime_ns, after.st_size) and \
+                after.st_mtime_ns < time.time_ns() - 2_000_000_000:
+            return
+        time.sleep(2.0)
 
 
 def _pdeathsig_term():

@@ -18,18 +18,30 @@ STYLE = {"font.family": "serif", "font.size": 8, "axes.labelsize": 8, "legend.fo
          "ytick.labelsize": 7, "lines.linewidth": 0.9, "axes.grid": True, "grid.linewidth": 0.3, "savefig.dpi": 200}
 
 
+class PlotError(Exception):
+    """One line for the user: a CSV that cannot be read, a figure that cannot be written."""
+
+
 def load(csv_dir, label):
     path = Path(csv_dir) / f"{label}.csv"
     if not path.is_file():
         return None
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.reader(f))
+    except UnicodeDecodeError as e:
+        raise PlotError(f"{path}: not UTF-8 text (byte {e.start}); expected a CSV written by mft-export")
+    except OSError as e:
+        raise PlotError(f"cannot read {path}: {e.strerror or e}")
     if len(rows) < 2:
         return None
     cols = {name: [] for name in rows[0]}
-    for r in rows[1:]:
+    for line, r in enumerate(rows[1:], start=2):
         for name, v in zip(rows[0], r):
-            cols[name].append(float(v))
+            try:
+                cols[name].append(float(v))
+            except ValueError:
+                raise PlotError(f"{path}: line {line}, column {name}: not a number: {v[:40]!r}")
     return cols
 
 
@@ -37,8 +49,13 @@ def save(fig, out, name):
     """Writes the figure to out/name and frees it; returns the path."""
     fig.tight_layout()
     path = Path(out) / name
-    fig.savefig(path)
-    plt.close(fig)
+    try:
+        fig.savefig(path)
+    except OSError as e:  # a full disk: no half-written figure is left
+        path.unlink(missing_ok=True)
+        raise PlotError(f"cannot write {path}: {e.strerror or e}{' (disk full?)' if e.errno == 28 else ''}")
+    finally:
+        plt.close(fig)
     return path
 
 
@@ -91,9 +108,16 @@ def main():
         print(__doc__.strip())
         return 0 if len(sys.argv) == 2 else 2
     csv_dir, out = sys.argv[1], sys.argv[2]
-    Path(out).mkdir(parents=True, exist_ok=True)
     plt.rcParams.update(STYLE)
-    made = [p for p in (floating_base(csv_dir, out), hip_angles(csv_dir, out), contact_forces(csv_dir, out)) if p]
+    try:
+        Path(out).mkdir(parents=True, exist_ok=True)
+        made = [p for p in (floating_base(csv_dir, out), hip_angles(csv_dir, out), contact_forces(csv_dir, out)) if p]
+    except PlotError as e:
+        print(f"mft-plot: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"mft-plot: {e.filename or out}: {e.strerror or e}", file=sys.stderr)
+        return 2
     if not made:
         print(f"mft-plot: no gt_q, est_q or contact_force CSV in {csv_dir}", file=sys.stderr)
         return 1

@@ -190,6 +190,7 @@ const std::vector<KeyRange> kScenario = {
     {"scenario", "commands[].v_cmd_mps", -3.0, 3.0, "m/s", "speed command"},
     {"scenario", "pushes[].impulse_Ns", -100.0, 100.0, "N s", "push impulse"},
     {"scenario", "pushes[].at_s", 0.0, 3600.0, "s", "push time"},
+    {"scenario", "pushes[].at_phase", 0.0, 1.0, "-", "push at this phase of the swing"},
 };
 
 const std::vector<KeyRange> kTerrain = {

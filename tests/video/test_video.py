@@ -398,6 +398,23 @@ class Recorded(unittest.TestCase):
         self.assertFalse(out.exists())
         self.assertEqual([f.name for f in self.tmp.iterdir() if ".partial" in f.name], [])
 
+    @unittest.skipUnless(os.geteuid() == 0 and shutil.which("unshare"), "needs root and unshare for a small tmpfs")
+    def test_6_full_disk_is_an_error_and_leaves_nothing(self):
+        # ffmpeg exited 0 on a full disk and left an MP4 without its index (moov box); mft-export said
+        # "100 frames ... 10.00 s of video", exit 0. A 64 kB tmpfs of its own (unshare -m) is the full disk.
+        out = self.tmp / "full"
+        out.mkdir()
+        script = (f"mount -t tmpfs -o size=64k tmpfs {out} && {EXPORT} {self.rawlog} --video {out / 'v.mp4'} "
+                  f"--from 2.0 --to 3.0; echo rc=$?; ls -A {out}")
+        p = subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c", script], capture_output=True,
+                           text=True, timeout=300)
+        if "rc=" not in p.stdout:
+            self.skipTest(f"cannot mount a tmpfs here: {p.stderr.strip()}")
+        self.assertEqual(p.stdout.split(), ["rc=2"], p.stderr)  # exit 2 and nothing left in the folder
+        self.assertRegex(p.stderr, r"mft-export: (the encoder left .*v\.mp4 incomplete \(.*; disk full\?\)|"
+                                   r"ffmpeg failed).*no video written|No space left on device")
+        self.assertNotIn("Traceback", p.stderr)
+
 
 SCENARIO_FILE_PLACEHOLDER = object()
 

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -270,6 +271,33 @@ class Panel {
   bool have_contact_ = false;
 };
 
+// Why the MP4 at `path` is not whole, or "": its top-level boxes must tile the file and hold the index (moov),
+// which ffmpeg writes last. On a full disk ffmpeg exited 0 and left a file without it, which no player opens.
+std::string incompleteMp4(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<std::uint64_t>(std::max<std::streamoff>(0, in.tellg()));
+  in.seekg(0);
+  bool has_moov = false;
+  for (std::uint64_t at = 0; at < size;) {
+    unsigned char box[16] = {};
+    if (size - at < 8 || !in.read(reinterpret_cast<char*>(box), 8)) return "cut inside a box header";
+    std::uint64_t len = (std::uint64_t{box[0]} << 24) | (box[1] << 16) | (box[2] << 8) | box[3];
+    if (len == 1) {
+      if (size - at < 16 || !in.read(reinterpret_cast<char*>(box + 8), 8)) return "cut inside a box header";
+      len = 0;
+      for (int i = 8; i < 16; ++i) len = (len << 8) | box[i];
+    } else if (len == 0) {
+      len = size - at;  // to the end of the file
+    }
+    if (len < 8 || len > size - at) return "a box runs past the end of the file";
+    has_moov = has_moov || std::string(reinterpret_cast<char*>(box + 4), 4) == "moov";
+    at += len;
+    in.seekg(static_cast<std::streamoff>(at));
+  }
+  return has_moov ? "" : "no index (moov box)";
+}
+
 std::string lowerExtension(const std::string& path) {
   std::string e = fs::path(path).extension().string();
   std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -429,6 +457,13 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
     double end = 0.0;
     for (const auto& p : panels) end = std::max(end, p->hasSample() ? p->sampleTime() : 0.0);
     cli.fail("--from " + cli.get("from") + " s is not before the end of the recording (" + seconds(end) + ")");
+  }
+  const std::string cut = ext == ".mp4" ? incompleteMp4(tmp) : "";
+  if (!cut.empty()) {
+    removeTmp();
+    std::fprintf(stderr, "mft-export: the encoder left %s incomplete (%s; disk full?): no video written\n",
+                 out.c_str(), cut.c_str());
+    return kExitBadInput;
   }
   fs::rename(tmp, out);
   bool corrupt = false;

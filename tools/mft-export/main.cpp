@@ -113,6 +113,7 @@ int exportMain(int argc, char** argv) {
   std::vector<double> values;
   std::string cells;
   std::int64_t last_unix_ns = 0, first_unix_ns = -1;
+  std::vector<std::string> csv_paths;  // removed if writing fails: a cut CSV looks like a short run
   while (reader->next(&obs)) {
     const int li = rawlog::labelIndex(obs->sensorLabel);
     if (li < 0 || !rawlog::observationValues(*obs, li, &values) || !rawlog::observationCells(*obs, li, &cells)) {
@@ -139,6 +140,7 @@ int exportMain(int argc, char** argv) {
       if (!in.csv) {
         const std::string path = (fs::path(csv_dir) / (spec.label + ".csv")).string();
         in.csv = std::fopen(path.c_str(), "w");
+        if (in.csv) csv_paths.push_back(path);
         if (!in.csv) {
           std::fprintf(stderr, "mft-export: cannot write %s: %s\n", path.c_str(), std::strerror(errno));
           return kExitBadInput;
@@ -160,7 +162,13 @@ int exportMain(int argc, char** argv) {
       csv_write_failed = (std::fclose(in.csv) != 0) || failed || csv_write_failed;
     }
   if (csv_write_failed) {
-    std::fprintf(stderr, "mft-export: writing the CSV files in %s failed (disk full?)\n", csv_dir.c_str());
+    std::string names;
+    for (const auto& p : csv_paths) {
+      std::remove(p.c_str());
+      names += (names.empty() ? "" : ", ") + fs::path(p).filename().string();
+    }
+    std::fprintf(stderr, "mft-export: writing the CSV files in %s failed (disk full?): removed the %zu cut files (%s)\n",
+                 csv_dir.c_str(), csv_paths.size(), names.c_str());
     return kExitBadInput;
   }
 

@@ -8,11 +8,48 @@
 
 namespace mft::config {
 
+std::size_t utf8Length(const std::string& text, std::size_t at) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(text[i]); };
+  const unsigned char lead = byte(at);
+  if (lead < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned min = 0;
+  if ((lead & 0xe0) == 0xc0) n = 2, min = 0x80;
+  else if ((lead & 0xf0) == 0xe0) n = 3, min = 0x800;
+  else if ((lead & 0xf8) == 0xf0) n = 4, min = 0x10000;
+  else return 0;
+  if (at + n > text.size()) return 0;
+  unsigned code = lead & (0x7f >> n);
+  for (std::size_t i = 1; i < n; ++i) {
+    if ((byte(at + i) & 0xc0) != 0x80) return 0;
+    code = (code << 6) | (byte(at + i) & 0x3f);
+  }
+  // Overlong forms, UTF-16 surrogates and code points past U+10FFFF are not UTF-8.
+  if (code < min || (code >= 0xd800 && code <= 0xdfff) || code > 0x10ffff) return 0;
+  return n;
+}
+
+bool isUtf8(const std::string& text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8Length(text, i);
+    if (n == 0) return false;
+    i += n;
+  }
+  return true;
+}
+
 std::string jsonEscape(const std::string& text) {
   std::string out;
   out.reserve(text.size() + 8);
-  for (const char c : text) {
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
     const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x80) {  // a whole UTF-8 sequence as it is; a byte that is not one as U+FFFD (JSON is UTF-8)
+      const std::size_t n = utf8Length(text, i);
+      if (n == 0) out += "\\ufffd";
+      else out.append(text, i, n), i += n - 1;
+      continue;
+    }
     switch (c) {
       case '"': out += "\\\""; break;
       case '\\': out += "\\\\"; break;

@@ -12,8 +12,12 @@
 
 namespace mft::config {
 
+// The length of the UTF-8 sequence that starts at `at` (1-4), or 0 if the bytes there are not one.
+std::size_t utf8Length(const std::string& text, std::size_t at);
+bool isUtf8(const std::string& text);
 // The text of a JSON string without the quotes: '"', '\\' and every control character escaped (RFC 8259),
-// so that a scenario name or a file name with a tab or an ESC still gives valid JSON. Bytes >= 0x80 pass.
+// so that a scenario name or a file name with a tab or an ESC still gives valid JSON. A whole UTF-8 sequence
+// passes; a byte that is not part of one (Latin-1) becomes \ufffd, so the JSON stays UTF-8.
 std::string jsonEscape(const std::string& text);
 // jsonEscape with the quotes.
 std::string jsonString(const std::string& text);

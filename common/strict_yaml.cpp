@@ -1,6 +1,7 @@
 #include "common/strict_yaml.hpp"
 
 #include "common/config_schema.hpp"
+#include "common/json_writer.hpp"
 #include "common/profiles.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -228,7 +229,15 @@ std::array<double, 2> StrictNode::orderedNumberPair(const std::string& key, bool
   return v;
 }
 
-std::string StrictNode::text(const std::string& key) { return take(key, Shape::Scalar, "expected a string").Scalar(); }
+std::string StrictNode::text(const std::string& key) {
+  const std::string value = take(key, Shape::Scalar, "expected a string").Scalar();
+  // Text goes into summaries and JSON reports, which are UTF-8: a Latin-1 byte is refused here, with its place.
+  for (std::size_t i = 0; i < value.size(); i += utf8Length(value, i))
+    if (utf8Length(value, i) == 0)
+      fail(key, "not UTF-8 text (byte " + std::to_string(i) + " is 0x" + "0123456789abcdef"[(value[i] >> 4) & 0xf] +
+                    "0123456789abcdef"[value[i] & 0xf] + "); save the file as UTF-8");
+  return value;
+}
 
 std::vector<double> StrictNode::numbers(const std::string& key, std::size_t expected_size) {
   const YAML::Node n = take(key, Shape::List, "expected a list of numbers");
@@ -256,6 +265,7 @@ std::vector<std::string> StrictNode::texts(const std::string& key) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < n.size(); ++i) {
     if (!n[i].IsScalar()) fail(key, "element " + std::to_string(i) + " is not a string");
+    if (!isUtf8(n[i].Scalar())) fail(key, "element " + std::to_string(i) + " is not UTF-8 text");
     out.push_back(n[i].Scalar());
   }
   return out;

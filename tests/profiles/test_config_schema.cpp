@@ -11,6 +11,7 @@
 
 #include "chain/scenario.hpp"
 #include "common/config_schema.hpp"
+#include "common/json_writer.hpp"
 #include "common/live_tuning.hpp"
 #include "common/strict_yaml.hpp"
 #include "planner/planner_config.hpp"
@@ -102,6 +103,23 @@ TEST(ConfigSchema, LiveValueCheckOfMftCmd) {
   EXPECT_NE(liveValueError("wbc", "gains.swing_foot.kp", "[300, 1e9]").find("must lie in"), std::string::npos);
   EXPECT_EQ(liveValueError("wbc", "gains.swing_foot.kp", "[300, 300]"), "");
   EXPECT_EQ(liveValueError("wbc", "variant", "sa"), "");  // not numeric: left to the service
+}
+
+// A Latin-1 byte in a text value was accepted and then written into summaries and JSON reports as invalid UTF-8.
+TEST(ConfigText, Latin1IsRefusedAndJsonStaysUtf8) {
+  std::string text = plannerText();
+  text.replace(text.find("first_swing_leg: right"), 22, "first_swing_leg: r\xe9ght");
+  try {
+    planner::parsePlannerConfig(text, "planner.yaml");
+    FAIL() << "a Latin-1 byte was accepted";
+  } catch (const config::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("gait.first_swing_leg: not UTF-8 text (byte 1 is 0xe9)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(config::jsonEscape("caf\xe9 \xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 \xc0\xaf"),
+            "caf\\ufffd \xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 \\ufffd\\ufffd");
+  EXPECT_TRUE(config::isUtf8("\xc3\xa9"));
+  EXPECT_FALSE(config::isUtf8("\xed\xa0\x80"));  // a UTF-16 surrogate
 }
 
 TEST(ConfigSchema, ListEntriesUseTheirListRange) {

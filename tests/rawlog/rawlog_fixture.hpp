@@ -6,9 +6,23 @@
 #include <cstdio>
 #include <vector>
 
-#include "services/record/rawlog_format.hpp"
+#include "services/record/rawlog_reader.hpp"
 
 namespace mft::rawlog::fixture {
+
+// Every whole message of a file, in file order, and the assembler's counts of incomplete and unknown ones.
+inline std::vector<Message> readAll(RawlogReader& r, std::uint64_t* incomplete = nullptr, std::uint64_t* unknown = nullptr) {
+  MessageAssembler a(r.metadata().time_base_unix_ns);
+  std::vector<Message> out;
+  mrpt::obs::CObservation::Ptr obs;
+  Message m;
+  std::int64_t t;
+  while (r.next(&obs))
+    if (a.add(*obs, &m, &t)) out.push_back(m);
+  if (incomplete) *incomplete = a.incomplete();
+  if (unknown) *unknown = a.unknown();
+  return out;
+}
 
 inline double val(std::uint64_t k, int i) { return 0.125 * static_cast<double>(k) + 1.0 / (3.0 + i) - 0.5 * i; }
 

@@ -25,6 +25,7 @@
 #include "idl/msg_pubsub.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/record/recorder.hpp"
+#include "tests/rawlog/rawlog_fixture.hpp"
 
 using namespace mft;
 using namespace mft::rawlog;
@@ -103,16 +104,7 @@ void recordTicks(const RecorderOptions& opt, std::uint64_t ticks, std::uint64_t 
   rec.stop();
 }
 
-std::vector<Message> readAll(RawlogReader& r) {
-  MessageAssembler a(r.metadata().time_base_unix_ns);
-  std::vector<Message> out;
-  mrpt::obs::CObservation::Ptr obs;
-  Message m;
-  std::int64_t t;
-  while (r.next(&obs))
-    if (a.add(*obs, &m, &t)) out.push_back(m);
-  return out;
-}
+std::vector<Message> readAll(RawlogReader& r) { return fixture::readAll(r); }
 
 }  // namespace
 

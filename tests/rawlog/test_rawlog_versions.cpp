@@ -24,16 +24,12 @@ namespace {
 
 const std::string kSchema1File = std::string(MFT_TEST_DATA_DIR) + "/rawlog/schema1.rawlog";
 
+// Every message of the file, none of them incomplete or unknown.
 std::vector<Message> readAll(RawlogReader& r) {
-  MessageAssembler a(r.metadata().time_base_unix_ns);
-  std::vector<Message> out;
-  mrpt::obs::CObservation::Ptr obs;
-  Message m;
-  std::int64_t t;
-  while (r.next(&obs))
-    if (a.add(*obs, &m, &t)) out.push_back(m);
-  EXPECT_EQ(a.incomplete(), 0u);
-  EXPECT_EQ(a.unknown(), 0u);
+  std::uint64_t incomplete = 0, unknown = 0;
+  auto out = fixture::readAll(r, &incomplete, &unknown);
+  EXPECT_EQ(incomplete, 0u);
+  EXPECT_EQ(unknown, 0u);
   return out;
 }
 

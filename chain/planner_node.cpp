@@ -1,11 +1,11 @@
 #include "chain/planner_node.hpp"
 
-#include "wbc/reference_from_plan.hpp"
+#include "chain/reference_from_plan.hpp"
 
 namespace mft::chain {
 
 const wbc::WbcReference& PlannerNode::plan(const model::RobotStateEstimate& estimate) {
-  reference_ = wbc::referenceFromPlan(planner_.update(state_builder_.build(estimate)));
+  reference_ = referenceFromPlan(planner_.update(state_builder_.build(estimate)));
   reference_.tick = estimate.tick;
   return reference_;
 }

@@ -1,6 +1,6 @@
 #pragma once
 // The planner stage of the chain: estimate(k) -> the scenario's commands due at t_k -> plan(k) -> the WBC's
-// reference(k) (the one PlanOutput -> WbcReference mapping, wbc/reference_from_plan.hpp). Operator commands
+// reference(k) (the one PlanOutput -> WbcReference mapping, chain/reference_from_plan.hpp). Operator commands
 // from outside the scenario go to planner() between applyScenarioCommands() and plan(): the operator has the
 // last word within a tick.
 #include <cstdint>

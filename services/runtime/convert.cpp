@@ -1,6 +1,6 @@
 #include "services/runtime/convert.hpp"
 
-#include "wbc/reference_from_plan.hpp"
+#include "chain/reference_from_plan.hpp"
 
 namespace mft::services {
 
@@ -90,9 +90,9 @@ void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out) {
 }
 
 void toMsg(const planner::PlanOutput& in, msg::Reference* out) {
-  // The controller's part goes through the shared mapping (wbc/reference_from_plan.hpp), the one the
+  // The controller's part goes through the shared mapping (chain/reference_from_plan.hpp), the one the
   // in-process closed loop uses too; the rest is schedule information for recording.
-  toMsg(in, wbc::referenceFromPlan(in), out);
+  toMsg(in, chain::referenceFromPlan(in), out);
 }
 
 void toMsg(const planner::PlanOutput& in, const wbc::WbcReference& r, msg::Reference* out) {

@@ -26,7 +26,7 @@ void toMsg(const model::ActuatorCommand& in, std::uint64_t stamp_ns, std::uint64
 void fromMsg(const msg::JointCommand& in, model::ActuatorCommand* out);
 
 void toMsg(const planner::PlanOutput& in, msg::Reference* out);
-// The same with the controller's part already mapped (`reference` = wbc::referenceFromPlan(in), as the planner
+// The same with the controller's part already mapped (`reference` = chain::referenceFromPlan(in), as the planner
 // node holds it).
 void toMsg(const planner::PlanOutput& in, const wbc::WbcReference& reference, msg::Reference* out);
 void fromMsg(const msg::Reference& in, wbc::WbcReference* out);

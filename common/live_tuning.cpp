@@ -9,17 +9,12 @@
 
 #include "common/config_schema.hpp"
 #include "common/strict_yaml.hpp"
+#include "common/text_split.hpp"
 
 namespace mft::config {
 namespace {
 
-std::vector<std::string> splitKey(const std::string& dotted) {
-  std::vector<std::string> parts;
-  std::stringstream ss(dotted);
-  std::string item;
-  while (std::getline(ss, item, '.')) parts.push_back(item);
-  return parts;
-}
+std::vector<std::string> splitKey(const std::string& dotted) { return splitOn(dotted, '.'); }
 
 }  // namespace
 

@@ -14,7 +14,11 @@ using config::ConfigError;
 using config::StrictNode;
 
 bool MftLegPolygon::contains(double q_rear, double q_fore, double tol) const {
-  return ((A * Eigen::Vector2d(q_rear, q_fore) - b).array() <= tol).all();
+  return A.rows() == 0 || violation(q_rear, q_fore) <= tol;
+}
+
+double MftLegPolygon::violation(double q_rear, double q_fore) const {
+  return polytopeViolation(A, b, Eigen::Vector2d(q_rear, q_fore));
 }
 
 MftLegPolygon MftLegPolygon::fromHalfPlanes(const HalfPlanePolygon& p) {

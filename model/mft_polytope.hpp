@@ -24,6 +24,8 @@ struct MftLegPolygon {
   Eigen::VectorXd b;
   std::vector<Eigen::Vector2d> vertices;        // counter-clockwise
   bool contains(double q_rear, double q_fore, double tol = 0.0) const;
+  // Paper (10) for this leg alone: max(A_leg [q_rear, q_fore] - b_leg) [rad], <= 0 inside.
+  double violation(double q_rear, double q_fore) const;
   static MftLegPolygon fromHalfPlanes(const HalfPlanePolygon& p);
 };
 
@@ -41,11 +43,14 @@ struct MftFitSummary {
   int reachable_cells = 0;
 };
 
-// Paper (10): the largest row of A q_a - b, q_a = [q4, q6, q8, q10]; <= 0 inside the preferable polytope.
-template <int Rows>
-double polytopeViolation(const Eigen::Matrix<double, Rows, kNa>& A, const Eigen::Matrix<double, Rows, 1>& b,
-                         const VectorA& q_a) {
-  return (A * q_a - b).maxCoeff();
+// Paper (10): the largest row of A q - b; <= 0 inside the preferable polytope. The one computation of the MFT
+// violation: over q_a = [q4, q6, q8, q10] with the augmented A (the WBC's diagnostics, mft-closedloop), over one
+// leg's rows of it (MftPolytope::legViolation, `mft-space violation`), or over (q_rear, q_fore) with a leg polygon.
+// Fixed-size arguments allocate nothing (the controller calls it every tick).
+template <typename DerivedA, typename DerivedB, typename DerivedQ>
+double polytopeViolation(const Eigen::MatrixBase<DerivedA>& A, const Eigen::MatrixBase<DerivedB>& b,
+                         const Eigen::MatrixBase<DerivedQ>& q) {
+  return (A * q - b).maxCoeff();
 }
 
 struct MftPolytope {
@@ -59,7 +64,13 @@ struct MftPolytope {
   std::string source_file;
 
   // q_a = [q4, q6, q8, q10].
-  bool contains(const VectorA& q_a, double tol = 0.0) const { return polytopeViolation(A, b, q_a) <= tol; }
+  bool contains(const VectorA& q_a, double tol = 0.0) const { return violation(q_a) <= tol; }
+  double violation(const VectorA& q_a) const { return polytopeViolation(A, b, q_a); }
+  // Leg 0 (right: q4, q6) or 1 (left: q8, q10): the rows of (10) that belong to that leg.
+  double legViolation(int leg_index, const VectorA& q_a) const {
+    const int first = leg_index * kMftLegEdges;
+    return polytopeViolation(A.middleRows<kMftLegEdges>(first), b.segment<kMftLegEdges>(first), q_a);
+  }
 };
 
 // blkdiag(A_leg, A_leg) and [b_leg; b_leg]; needs a hexagon.

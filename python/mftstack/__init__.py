@@ -2,6 +2,7 @@
 
   paths       the repository, built executables, configuration and runs folders (one place)
   processes   the supervised service processes: argv, start order, readiness, restart back-off, logs, stop
+  registry    the one process registry: children bound to their parent's life, stopped by pid (mft-experiment)
   stackfile   multi-host stack files and their hosts
   ddsxml      the per-host DDS profiles of a stack file
   checks      everything checked before the first service starts

@@ -2,7 +2,6 @@
 
 Stack builds every service's command line (the service contract, with the host's DDS profile of a stack
 file, docs/distributed.md) and supervises the processes; Service is one child with its log and summary."""
-import ctypes
 import json
 import os
 import re
@@ -15,6 +14,7 @@ from pathlib import Path
 from .ddsxml import DISCOVERY_SERVER, write_host_profiles
 from .errors import Interrupted, SupervisorError, log, os_problem
 from .paths import DEFAULT_RUNS
+from .registry import set_pdeathsig
 
 # Start order: the simulator owns the clock, so it starts last, once every consumer listens.
 CORE_SERVICES = ["mft-estimator", "mft-planner", "mft-wbc"]
@@ -35,11 +35,6 @@ SECURE_RUN_ATTEMPTS = 2
 DISCOVERY_SERVER_READY = "### Server is running ###"
 
 
-def _set_pdeathsig(sig=signal.SIGKILL):
-    # Runs in the child between fork and exec: die with the supervisor, whatever killed it.
-    libc = ctypes.CDLL("libc.so.6", use_errno=True)
-    PR_SET_PDEATHSIG = 1
-    libc.prctl(PR_SET_PDEATHSIG, sig)
 
 
 def chain_cpu_for(chain_cpu, mode, domain, multi_host):
@@ -202,7 +197,7 @@ class Service:
         death_signal = signal.SIGTERM if self.name == "mft-record" else signal.SIGKILL
 
         def before_exec():
-            _set_pdeathsig(death_signal)
+            set_pdeathsig(death_signal)  # bound to the supervisor's life, whatever killed it
             if cpus:
                 os.sched_setaffinity(0, cpus)
 

@@ -4,10 +4,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "model/mft_polytope.hpp"
 
 namespace {
 struct CliRun {
@@ -86,4 +90,46 @@ TEST(MftSpaceCli, StanceTableMarksInsideAndOutside) {
   std::size_t count_in = 0, pos = 0;
   while ((pos = r.out.find("\"inside_polygon\": true", pos)) != std::string::npos) ++count_in, ++pos;
   EXPECT_EQ(count_in, 3u) << r.out;  // 0.38, 0.40, 0.42
+}
+
+TEST(MftSpaceCli, ViolationPerRowMatchesTheRowsWrittenOut) {
+  // `violation` on a small CSV against the polytope's rows written out by hand (the columns it passes through,
+  // each leg's rows, the augmented maximum), and its one-line errors.
+  const mft::model::RobotDescription robot = mft::model::loadRobotDescription(std::string(MFT_CONFIG_DIR) + "/robot.yaml");
+  const mft::model::MftPolytope p = mft::model::loadMftPolytope(std::string(MFT_CONFIG_DIR) + "/mft_space.yaml", robot);
+  const std::string in = ::testing::TempDir() + "/mft_cli_q_" + std::to_string(getpid()) + ".csv";
+  const double q[3][4] = {{-0.64, 0.64, -0.64, 0.64}, {0.3, 1.4, -0.9, 0.2}, {-1.5, -0.2, 0.1, 1.9}};
+  {
+    std::ofstream f(in);
+    f << "stamp_ns,time_s,tick,x,q4,q6,q8,q10\n";
+    for (int r = 0; r < 3; ++r) f << r * 1000000 << "," << r * 0.001 << "," << r << ",0," << q[r][0] << "," << q[r][1] << "," << q[r][2] << "," << q[r][3] << "\n";
+  }
+  const CliRun r = run("violation --csv " + in);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::stringstream lines(r.out);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "stamp_ns,time_s,tick,mft_violation_right,mft_violation_left,mft_violation");
+  for (int row = 0; row < 3; ++row) {
+    ASSERT_TRUE(std::getline(lines, line));
+    double leg[2] = {-1e300, -1e300};
+    for (int l = 0; l < 2; ++l)
+      for (int k = 0; k < mft::model::kMftLegEdges; ++k)
+        leg[l] = std::max(leg[l], p.leg.A(k, 0) * q[row][2 * l] + p.leg.A(k, 1) * q[row][2 * l + 1] - p.leg.b[k]);
+    double tick = -1, right = 0, left = 0, all = 0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%*[^,],%*[^,],%lf,%lf,%lf,%lf", &tick, &right, &left, &all), 4) << line;
+    EXPECT_EQ(tick, row);
+    EXPECT_NEAR(right, leg[0], 1e-12);
+    EXPECT_NEAR(left, leg[1], 1e-12);
+    EXPECT_NEAR(all, std::max(leg[0], leg[1]), 1e-12);
+  }
+  {
+    std::ofstream f(in);
+    f << "tick,q4,q6,q8\n1,0,0,0\n";
+  }
+  const CliRun missing = run("violation --csv " + in);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("needs the columns q4, q6, q8, q10"), std::string::npos) << missing.err;
+  expectUsage("violation", "missing required option --csv");
+  std::remove(in.c_str());
 }

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <regex>
@@ -148,4 +149,36 @@ TEST(MftPolytope, ViolationIsTheLargestRowOfAqMinusB) {
   }
   EXPECT_GT(inside, 10);   // the sample straddles the boundary: both answers occur
   EXPECT_LT(inside, 190);
+}
+
+TEST(MftPolytope, LegViolationIsTheLegsRowsAndTheAugmentedIsTheWorseLeg) {
+  // Each leg's violation from its own polygon, the augmented (10) split into its legs' rows, and their maximum:
+  // the three forms the tools use must agree with the row-by-row value.
+  const RobotDescription robot = loadRobotDescription(robotPath());
+  const MftPolytope p = loadMftPolytope(polytopePath(), robot);
+  std::srand(11);
+  for (int k = 0; k < 200; ++k) {
+    const VectorA q = VectorA(-0.6435, 0.6435, -0.6435, 0.6435) + 0.6 * VectorA::Random();
+    double by_hand[2] = {-1e300, -1e300};
+    for (int leg = 0; leg < 2; ++leg)
+      for (int r = 0; r < kMftLegEdges; ++r)
+        by_hand[leg] = std::max(by_hand[leg], p.leg.A(r, 0) * q[2 * leg] + p.leg.A(r, 1) * q[2 * leg + 1] - p.leg.b[r]);
+    for (int leg = 0; leg < 2; ++leg) {
+      EXPECT_NEAR(p.legViolation(leg, q), by_hand[leg], 1e-12);
+      EXPECT_NEAR(p.leg.violation(q[2 * leg], q[2 * leg + 1]), by_hand[leg], 1e-12);
+    }
+    EXPECT_NEAR(p.violation(q), std::max(by_hand[0], by_hand[1]), 1e-12);
+  }
+}
+
+TEST(MftPolytope, ViolationOfASquareInClosedForm) {
+  // |q_rear| <= 1, |q_fore| <= 1 as four unit rows: the violation is max(|q_rear|, |q_fore|) - 1.
+  HalfPlanePolygon square;
+  square.angle = {0.0, M_PI / 2, M_PI, 3 * M_PI / 2};
+  square.offset = {1.0, 1.0, 1.0, 1.0};
+  const MftLegPolygon leg = MftLegPolygon::fromHalfPlanes(square);
+  for (const auto& [qr, qf] : std::vector<std::pair<double, double>>{{0, 0}, {0.5, -0.25}, {1.5, 0.2}, {-0.3, -2.0}, {1, 1}})
+    EXPECT_NEAR(leg.violation(qr, qf), std::max(std::abs(qr), std::abs(qf)) - 1.0, 1e-12) << qr << "," << qf;
+  EXPECT_TRUE(leg.contains(1.0, -1.0));
+  EXPECT_FALSE(leg.contains(1.01, 0.0));
 }

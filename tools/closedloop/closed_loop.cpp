@@ -168,7 +168,7 @@ void ClosedLoop::accumulate() {
   s.est_rms_vx = std::sqrt(sum_est_vx2_ / n);
   model::VectorA qa;
   for (int i = 0; i < model::kNa; ++i) qa[i] = truth.q[model::kActuatedIndex[i]];
-  s.max_mft_violation = std::max(s.max_mft_violation, (configs_.polytope.A * qa - configs_.polytope.b).maxCoeff());
+  s.max_mft_violation = std::max(s.max_mft_violation, configs_.polytope.violation(qa));
   s.min_lti = std::min({s.min_lti, truth.lti[0], truth.lti[1]});
 }
 

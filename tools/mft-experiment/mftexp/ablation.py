@@ -147,7 +147,8 @@ def imax(cell):
     return cell["i_max_Ns"], f"{cell['i_max_Ns']:.1f}"
 
 
-def write_report(args, sweep, variants, sens_variants, sens, wall, load):
+def _variant_rows(args, sweep, variants):
+    """Per variant and height: both controllers' I_max, its text, the ratio and the recoveries above."""
     res = sweep.results
     d = sweep.setup.direction
     rows = []
@@ -160,6 +161,13 @@ def write_report(args, sweep, variants, sens_variants, sens, wall, load):
                                           "sa_above": (sa or {}).get("recovered_above_Ns"),
                                           "mft_above": (mft or {}).get("recovered_above_Ns")}
         rows.append(row)
+    return rows
+
+
+def _sensitivity_rows(args, sweep, sens_variants, sens):
+    """Per value of --param: each controller's I_max and stepping height."""
+    res = sweep.results
+    d = sweep.setup.direction
     sens_rows = []
     for (val, name), v in zip(sens, sens_variants):
         r = {"value": val, "variant": name}
@@ -169,10 +177,11 @@ def write_report(args, sweep, variants, sens_variants, sens, wall, load):
             st = res.extra.get("stepping", {}).get(f"{name}/{c}")
             r[f"{c}_stepping_height_m"] = st and st["mean_base_height_m"]
         sens_rows.append(r)
-    defaults_stepping = {c: (res.extra.get("stepping", {}).get(f"defaults/{c}") or {}).get("mean_base_height_m")
-                         for c in args.controllers}
-    out = Path(args.out)
-    with open(out / "ablation.csv", "w", newline="") as f:
+    return sens_rows
+
+
+def _write_csv(path, args, rows, sens_rows):
+    with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["variant", "profiles", "rule"] + [f"{k}_{h:.2f}" for h in args.heights
                                                        for k in ("sa_imax_Ns", "mft_imax_Ns", "mft_sa_ratio")])
@@ -190,6 +199,12 @@ def write_report(args, sweep, variants, sens_variants, sens, wall, load):
                 w.writerow([args.param, f"{r['value']:g}", f"{args.sensitivity_height:.2f}"] +
                            [("" if r[f"{c}_{k}"] is None else f"{r[f'{c}_{k}']:.4f}")
                             for c in args.controllers for k in ("imax_Ns", "stepping_height_m")])
+
+
+def _markdown(args, sweep, rows, sens_rows, defaults_stepping, wall, load):
+    """ablation.md: the variants' table, the recoveries above a failure, the sensitivity table, the wall time."""
+    res = sweep.results
+    d = sweep.setup.direction
     hs = args.heights
     lines = [f"Ablation: each departure from the paper's setup alone ({d} push at a {sweep.setup.liftoff}-foot lift-off, "
              f"grid {args.start:g} + k·{args.step:g} N s, search {args.search}"
@@ -225,6 +240,19 @@ def write_report(args, sweep, variants, sens_variants, sens, wall, load):
     if wall is not None:
         lines += ["", f"Wall time of this invocation: {wall / 60:.1f} min (load average before / after: {load[0]} / "
                       f"{load[1]}); {sweep.new_runs} new runs, {len(res.runs)} on file."]
+    return lines
+
+
+def write_report(args, sweep, variants, sens_variants, sens, wall, load):
+    res = sweep.results
+    rows = _variant_rows(args, sweep, variants)
+    sens_rows = _sensitivity_rows(args, sweep, sens_variants, sens)
+    defaults_stepping = {c: (res.extra.get("stepping", {}).get(f"defaults/{c}") or {}).get("mean_base_height_m")
+                         for c in args.controllers}
+    out = Path(args.out)
+    hs = args.heights
+    _write_csv(out / "ablation.csv", args, rows, sens_rows)
+    lines = _markdown(args, sweep, rows, sens_rows, defaults_stepping, wall, load)
     (out / "ablation.md").write_text("\n".join(lines) + "\n")
     return {"kind": "ablation", "out": str(out), "grid": sweep.grid, "heights": hs, "rows": rows,
             "sensitivity": {"param": args.param, "height_m": args.sensitivity_height, "rows": sens_rows,

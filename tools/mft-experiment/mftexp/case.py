@@ -3,9 +3,10 @@ import threading
 import time
 from pathlib import Path
 
-from .common import (CONTROLLER_NAMES, REPO, REGISTRY, ExperimentError, Interrupted, check_scenario, export_csv, log,
-                     pyplot, read_csv, run_scenario, run_workers, write_report)
+from .common import (CONTROLLER_NAMES, REPO, REGISTRY, ExperimentError, Interrupted, check_scenario, export_csv,
+                     load_yaml, log, pyplot, read_csv, run_scenario, run_workers, write_report)
 from . import push as pushmod
+from .mft_space import mft_violations
 
 COLORS = {"mft": "tab:blue", "sa": "tab:orange", "none": "tab:gray"}
 
@@ -86,7 +87,8 @@ def cmd_case(args, setup):
         traces[c] = {"q": read_csv(csv_dir / "gt_q.csv"), "qd": read_csv(csv_dir / "gt_qd.csv"),
                      "lti": read_csv(csv_dir / "leg_lti.csv"), "plan": read_csv(csv_dir / "plan_ref.csv"),
                      "tau_cmd": read_csv(csv_dir / "joint_tau_cmd.csv"),
-                     "tau_meas": read_csv(csv_dir / "joint_tau_meas.csv")}
+                     "tau_meas": read_csv(csv_dir / "joint_tau_meas.csv"),
+                     "mft": mft_violations(args.bin_dir, args.config_dir, csv_dir / "gt_q.csv")}
         rec = sim["recovery"]
         report["controllers"][c] = {
             "recovered": recovered, "reason": reason, "fell": sim.get("fell"), "fall_time_s": sim.get("fall_time_s"),
@@ -173,7 +175,6 @@ def plot_case(path, args, setup, report, traces):
 
 def hip_torque_limit(config_dir):
     """The hips' output peak torque [N m] from robot.yaml: gear ratio x motor peak torque (x efficiency)."""
-    from .terrain import load_yaml
     a = (load_yaml(Path(config_dir) / "robot.yaml") or {}).get("actuator") or {}
     try:
         return float(a["gear_ratio"]) * float(a["motor_peak_torque_Nm"]) * float(a.get("gearbox_efficiency", 1.0))
@@ -181,17 +182,15 @@ def hip_torque_limit(config_dir):
         raise ExperimentError(f"{config_dir}/robot.yaml has no actuator gear_ratio / motor_peak_torque_Nm")
 
 
-def stance_leg_traces(tr, rows, b):
+def stance_leg_traces(tr):
     """Per tick: the planner's stance leg's LTI and its distance outside the polytope's leg hexagon
     max(A_leg [q_rear, q_fore] - b_leg) [rad] (double support: the worse leg)."""
-    from .terrain import violation
-    q, lti, plan = tr["q"], tr["lti"], tr["plan"]
+    q, lti, plan, mft = tr["q"], tr["lti"], tr["plan"], tr["mft"]
     by_tick = {int(t): s for t, s in zip(plan["tick"], plan["stance_leg"])}
     t_out, l_out, v_out = [], [], []
     for i, tick in enumerate(q["tick"]):
         s = by_tick.get(int(tick), -1)
-        vr = violation(rows, b, q["q4"][i], q["q6"][i])
-        vl = violation(rows, b, q["q8"][i], q["q10"][i])
+        vr, vl = mft["mft_violation_right"][i], mft["mft_violation_left"][i]
         lr, ll = lti["lti_right"][i], lti["lti_left"][i]
         t_out.append(q["time_s"][i])
         l_out.append(lr if s == 0 else ll if s == 1 else min(lr, ll))
@@ -203,9 +202,7 @@ def plot_fig67(path, args, setup, report, traces):
     """The paper's Fig. 6/7 quantities for each controller (columns): base height and pitch, the stance leg's
     LTI with the preferable space's bound (LTI >= 0.7, which the polytope approximates) and its distance outside
     the polytope, the hip torque commands against the actuators' peak torque."""
-    from .terrain import leg_polygon
     plt = pyplot()
-    rows, b, _ = leg_polygon(args.config_dir)
     limit = hip_torque_limit(args.config_dir)
     cs = args.controllers[:2]
     fig, axes = plt.subplots(4, len(cs), figsize=(6.2 * len(cs), 10), dpi=110, squeeze=False, sharex=True)
@@ -225,7 +222,7 @@ def plot_fig67(path, args, setup, report, traces):
         ax.plot(tr["q"]["time_s"], tr["q"]["pitch"], color=COLORS.get(c), lw=1.2)
         ax.set_ylabel("pitch [rad]")
         ax = axes[2][col]
-        t, l, v = stance_leg_traces(tr, rows, b)
+        t, l, v = stance_leg_traces(tr)
         ax.plot(t, l, color=COLORS.get(c), lw=1.2, label="stance-leg LTI")
         ax.axhline(0.7, color="k", lw=0.8, ls="--", label="MFT space bound LTI 0.7")
         ax.set_ylabel("stance-leg LTI")

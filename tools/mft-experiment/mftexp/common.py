@@ -1,5 +1,4 @@
 """Shared pieces: errors, paths, binaries, process handling and progress lines."""
-import ctypes
 import json
 import os
 import signal
@@ -10,6 +9,8 @@ import time
 from pathlib import Path
 
 from mftstack.paths import DEFAULT_BIN, DEFAULT_CONFIG, REPO, SUPERVISOR  # noqa: F401 (the tools' one place)
+from mftstack.registry import ProcessRegistry
+
 SERVICES = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
 
 # The paper's Table II (section IV-B): I_max [N s] per reference height, SA-WBC and MFT-WBC.
@@ -72,7 +73,7 @@ def check_setup(bin_dir, config_dir, need=("mft-sim", "mft-estimator", "mft-plan
 
 
 SNAPSHOT = ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc", "mft-record", "mft-export", "mft-closedloop",
-            "mft-participants")  # mft-participants: the supervisor's domain probe
+            "mft-participants", "mft-space")  # mft-participants: the supervisor's domain probe; mft-space: eq. (10)
 
 
 def snapshot_binaries(bin_dir, dest):
@@ -134,59 +135,9 @@ def _copy_when_stable(src, dst):
         time.sleep(2.0)
 
 
-def _pdeathsig_term():
-    # Runs in the child between fork and exec: a supervisor gets SIGTERM (and stops its stack) when we die.
-    try:
-        libc = ctypes.CDLL("libc.so.6", use_errno=True)
-        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except OSError:
-        pass
-
-
-class ProcessRegistry:
-    """The supervisors this tool started (and only those): stopped by pid on Ctrl-C or an error."""
-
-    def __init__(self):
-        self._lock = threading.Lock()
-        self._procs = set()
-        self.stopping = threading.Event()
-
-    def popen(self, argv, **kw):
-        with self._lock:
-            if self.stopping.is_set():
-                raise Interrupted()
-            p = subprocess.Popen(argv, stdin=subprocess.DEVNULL, start_new_session=True,
-                                 preexec_fn=_pdeathsig_term, **kw)
-            self._procs.add(p)
-            return p
-
-    def done(self, p):
-        with self._lock:
-            self._procs.discard(p)
-
-    def stop_all(self, grace_s=15.0):
-        self.stopping.set()
-        with self._lock:
-            procs = list(self._procs)
-        for p in procs:
-            if p.poll() is None:
-                try:
-                    os.kill(p.pid, signal.SIGTERM)  # the supervisor stops its own children
-                except OSError:
-                    pass
-        deadline = time.monotonic() + grace_s
-        for p in procs:
-            try:
-                p.wait(timeout=max(0.1, deadline - time.monotonic()))
-            except subprocess.TimeoutExpired:
-                try:
-                    os.kill(p.pid, signal.SIGKILL)  # its children die with it (PR_SET_PDEATHSIG)
-                except OSError:
-                    pass
-                p.wait()
-
-
-REGISTRY = ProcessRegistry()
+# The supervisors this tool started (and only those), in mftstack's registry: stopped by pid on Ctrl-C or an error;
+# a supervisor gets SIGTERM (and stops its stack) when this process dies.
+REGISTRY = ProcessRegistry(interrupted=Interrupted, death_signal=signal.SIGTERM)
 
 
 def run_workers(worker, count, errors, interrupted_msg=None):
@@ -357,6 +308,17 @@ def export_csv(bin_dir, rawlog, out_dir, labels):
                         ",".join(labels)], capture_output=True, text=True, timeout=600)
     if p.returncode not in (0,):
         raise ExperimentError(f"mft-export failed on {rawlog}: {(p.stderr or p.stdout).strip()[-300:]}")
+
+
+def load_yaml(path):
+    try:
+        import yaml
+    except ImportError:
+        raise ExperimentError("python3-yaml is missing (Debian: apt-get install python3-yaml)")
+    try:
+        return yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError) as e:
+        raise ExperimentError(f"cannot read {path}: {e}")
 
 
 def load_text():

@@ -150,57 +150,79 @@ def imax_search(kmax, search, coarse_k=5, above_k=10):
     far and see which run it needs next, and which it would need if the runs in flight recover (Sweep.run)."""
     info = {"monotone": None, "checks": [], "non_monotone_scan": None}
     if search in ("linear", "coarse"):
-        step = 1 if search == "linear" else max(1, coarse_k)
-        k, last_ok, fail = 0, None, None
-        while k <= kmax:
-            if (yield k):
-                last_ok = k
-                k += step
-            else:
-                fail = k
+        return (yield from _scan_search(kmax, search, coarse_k, above_k, info))
+    lo, hi = yield from _bisect(kmax, coarse_k)
+    lo, hi = yield from _check_monotone(kmax, coarse_k, lo, hi, info)
+    if hi is not None:
+        above = []
+        for k in (hi + 1, hi + 2):
+            if k <= kmax:
+                above.append((k, (yield k)))
+        info["above"] = above
+    return lo, hi, info
+
+
+def _scan_search(kmax, search, coarse_k, above_k, info):
+    """linear: every grid point from 0; coarse: every coarse_k-th, then the fine grid below the first failure."""
+    step = 1 if search == "linear" else max(1, coarse_k)
+    k, last_ok, fail = 0, None, None
+    while k <= kmax:
+        if (yield k):
+            last_ok = k
+            k += step
+        else:
+            fail = k
+            break
+    if step > 1 and fail is not None:  # the fine grid between the last coarse recovery and the coarse failure
+        a = 0 if last_ok is None else last_ok + 1
+        for j in range(a, fail):
+            if not (yield j):
+                fail = j
                 break
-        if step > 1 and fail is not None:  # the fine grid between the last coarse recovery and the coarse failure
-            a = 0 if last_ok is None else last_ok + 1
-            for j in range(a, fail):
-                if not (yield j):
-                    fail = j
-                    break
-        elif step > 1 and fail is None and last_ok is not None and last_ok < kmax:
-            for j in range(last_ok + 1, kmax + 1):
-                if not (yield j):
-                    fail = j
-                    break
-        info["monotone"] = f"not assumed ({search} scan)"
-        lo = None if fail == 0 else (kmax if fail is None else fail - 1)
-        if fail is not None:  # what lies above the first failure, on the same grid
-            above = []
-            for j in range(fail + 1, min(kmax, fail + above_k) + 1, step):
-                above.append((j, (yield j)))
-            info["above"] = above
-        return lo, fail, info
-    # bisect
+    elif step > 1 and fail is None and last_ok is not None and last_ok < kmax:
+        for j in range(last_ok + 1, kmax + 1):
+            if not (yield j):
+                fail = j
+                break
+    info["monotone"] = f"not assumed ({search} scan)"
+    lo = None if fail == 0 else (kmax if fail is None else fail - 1)
+    if fail is not None:  # what lies above the first failure, on the same grid
+        above = []
+        for j in range(fail + 1, min(kmax, fail + above_k) + 1, step):
+            above.append((j, (yield j)))
+        info["above"] = above
+    return lo, fail, info
+
+
+def _bisect(kmax, coarse_k):
+    """Doubling steps from 0 until a failure, then bisection: (last recovered k or None, first failed k or None)."""
     lo = hi = None
     if not (yield 0):
-        lo, hi = None, 0
-    else:
-        lo, inc = 0, 2 * coarse_k
-        while True:
-            k = min(lo + inc, kmax)
-            if k == lo:
-                break
-            if (yield k):
-                lo = k
-                inc *= 2
+        return None, 0
+    lo, inc = 0, 2 * coarse_k
+    while True:
+        k = min(lo + inc, kmax)
+        if k == lo:
+            break
+        if (yield k):
+            lo = k
+            inc *= 2
+        else:
+            hi = k
+            break
+    if hi is not None:
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if (yield mid):
+                lo = mid
             else:
-                hi = k
-                break
-        if hi is not None:
-            while hi - lo > 1:
-                mid = (lo + hi) // 2
-                if (yield mid):
-                    lo = mid
-                else:
-                    hi = mid
+                hi = mid
+    return lo, hi
+
+
+def _check_monotone(kmax, coarse_k, lo, hi, info):
+    """Two points either side of the bisection's boundary; where one disagrees, the paper's scan from below the
+    boundary (or from I_0) up to the first failure decides. Returns the (lo, hi) in force."""
     checks = []
     if lo is not None:
         checks += [(k, True) for k in (lo - 1, lo - 2) if k >= 0]
@@ -212,28 +234,23 @@ def imax_search(kmax, search, coarse_k=5, above_k=10):
         info["checks"].append({"k": k, "expected": want, "recovered": got})
         ok = ok and got == want
     info["monotone"] = ok
-    if not ok:
-        w = 2 * coarse_k
-        a = max(0, (lo if lo is not None else 0) - w)
-        if a > 0 and not (yield a):
-            a = 0  # the window starts in a failure: the paper's scan from I_0
-        scan, first_fail = [], None
-        for k in range(a, kmax + 1):
-            r = yield k
-            scan.append({"k": k, "recovered": r})
-            if not r:
-                first_fail = k
-                break
-        info["non_monotone_scan"] = scan
-        hi = first_fail
-        lo = kmax if first_fail is None else (first_fail - 1 if first_fail > 0 else None)
-    if hi is not None:
-        above = []
-        for k in (hi + 1, hi + 2):
-            if k <= kmax:
-                above.append((k, (yield k)))
-        info["above"] = above
-    return lo, hi, info
+    if ok:
+        return lo, hi
+    w = 2 * coarse_k
+    a = max(0, (lo if lo is not None else 0) - w)
+    if a > 0 and not (yield a):
+        a = 0  # the window starts in a failure: the paper's scan from I_0
+    scan, first_fail = [], None
+    for k in range(a, kmax + 1):
+        r = yield k
+        scan.append({"k": k, "recovered": r})
+        if not r:
+            first_fail = k
+            break
+    info["non_monotone_scan"] = scan
+    hi = first_fail
+    lo = kmax if first_fail is None else (first_fail - 1 if first_fail > 0 else None)
+    return lo, hi
 
 
 def find_imax(rec, kmax, search, coarse_k=5, above_k=10):

@@ -4,14 +4,15 @@ and whether the left leg stayed inside the MFT preferable space while in stance 
 MFT convention (model/mft_polytope.hpp, config/mft_space.yaml): one polygon per leg, A_leg [q_rear, q_fore] <=
 b_leg with unit-norm rows (rad); for the left leg q_rear = q8 and q_fore = q10, the same polygon as the right leg
 (the augmented A = blkdiag(A_leg, A_leg) over q_a = [q4, q6, q8, q10] that the WBC uses). The violation of a
-sample is max(A_leg q - b_leg) in rad: <= 0 inside."""
+sample is max(A_leg q - b_leg) in rad: <= 0 inside, computed by `mft-space violation` (mft_space.py)."""
 import math
 import time
 from pathlib import Path
 
-from .common import (CONTROLLER_NAMES, ExperimentError, export_csv, pyplot, read_csv, write_report,
+from .common import (CONTROLLER_NAMES, ExperimentError, export_csv, load_yaml, pyplot, read_csv, write_report,
                      write_yaml_scenario)
 from .case import COLORS, controller_runs, run_pair
+from .mft_space import leg_polygon, mft_violations
 
 INSIDE_TOL_RAD = 0.01  # "stayed inside" allows the soft constraint's small predicted violations
 # The minimal departure from the paper's setup that the course needs (docs/experiments.md#terrain-fig-8): with the
@@ -24,17 +25,6 @@ def course_profiles(args):
     """The runs' profiles: COURSE_PROFILES (unless --paper-setup), then those given with --profile, each once."""
     first = [] if args.paper_setup else COURSE_PROFILES
     return first + [p for p in args.profile if p not in first]
-
-
-def load_yaml(path):
-    try:
-        import yaml
-    except ImportError:
-        raise ExperimentError("python3-yaml is missing (Debian: apt-get install python3-yaml)")
-    try:
-        return yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as e:
-        raise ExperimentError(f"cannot read {path}: {e}")
 
 
 def course_segments(terrain):
@@ -63,21 +53,6 @@ def ground_at(segs, x):
     if segs and x >= segs[-1][2]:
         return segs[-1][4]
     return segs[0][3] if segs and segs[0][0] != "board" else 0.0
-
-
-def leg_polygon(config_dir):
-    d = load_yaml(Path(config_dir) / "mft_space.yaml")
-    try:
-        A, b = d["leg_polygon"]["A"], d["leg_polygon"]["b"]
-        verts = d["leg_polygon"]["vertices"]
-    except (KeyError, TypeError):
-        raise ExperimentError(f"{config_dir}/mft_space.yaml has no leg_polygon A/b/vertices")
-    rows = [(A[2 * i], A[2 * i + 1]) for i in range(len(b))]
-    return rows, b, [(verts[2 * i], verts[2 * i + 1]) for i in range(len(verts) // 2)]
-
-
-def violation(rows, b, qr, qf):
-    return max(a0 * qr + a1 * qf - bi for (a0, a1), bi in zip(rows, b))
 
 
 def walk_scenario(height, speed, controller, terrain, duration, name, tool="terrain"):
@@ -113,7 +88,7 @@ def cmd_terrain(args):
                                 duration * 20 + 120)
     t0 = time.monotonic()
     runs = run_pair(args, jobs)
-    rows, b, verts = leg_polygon(args.config_dir)
+    verts = leg_polygon(args.config_dir)
     report = {"terrain": args.terrain, "speed_mps": args.speed, "height_m": args.height, "duration_s": duration,
               "profiles": list(args.profile),
               "course_end_x_m": round(course_end, 3),
@@ -128,6 +103,7 @@ def cmd_terrain(args):
                    ["gt_q", "gt_qd", "plan_ref", "contact_force", "joint_tau_cmd", "leg_lti"])
         tr = {k: read_csv(csv_dir / f"{k}.csv") for k in ("gt_q", "gt_qd", "plan_ref", "contact_force",
                                                            "joint_tau_cmd", "leg_lti")}
+        tr["mft"] = mft_violations(args.bin_dir, args.config_dir, csv_dir / "gt_q.csv")
         traces[c] = tr
         q = tr["gt_q"]
         max_x = max(q["x"]) if q["x"] else 0.0
@@ -139,7 +115,7 @@ def cmd_terrain(args):
             if not slopes or stance.get(tick, 0.0) < 0.5:
                 continue
             if any(s[1] <= q["x"][i] <= s[2] for s in slopes):
-                viol.append(violation(rows, b, q["q8"][i], q["q10"][i]))
+                viol.append(tr["mft"]["mft_violation_left"][i])
         mft_check = None
         if viol:
             mft_check = {"samples": len(viol), "max_violation_rad": round(max(viol), 4),
@@ -152,7 +128,7 @@ def cmd_terrain(args):
             "fall_x_m": round(q["x"][-1], 3) if sim.get("fell") and q["x"] else None,
             "average_speed_mps": sim.get("average_speed_mps"), "base_height_error_m": sim.get("base_height_error_m"),
             "left_stance_on_up_slope_mft": mft_check, "rawlog": str(out / f"{c}.rawlog"), "wall_s": round(wall, 1)}
-    png = plot_terrain(out / "terrain.png", args, report, traces, segs, slopes, rows, b, verts)
+    png = plot_terrain(out / "terrain.png", args, report, traces, segs, slopes, verts)
     if args.video:
         from .video import write_video
         report["video"] = write_video(args, [out / f"{c}.rawlog" for c in args.controllers], out / "terrain.mp4")["video"]
@@ -178,17 +154,28 @@ def _legend(ax, **kw):
         ax.legend(**kw)
 
 
-def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
+def plot_terrain(path, args, report, traces, segs, slopes, verts):
+    """The paper's Fig. 8: (a) the floating base over the course, (b) the left leg on the up-slope."""
     plt = pyplot()
     fig = plt.figure(figsize=(13, 8), dpi=110)
     gs = fig.add_gridspec(3, 3)
-    ax_z = fig.add_subplot(gs[0, 0:2])
-    ax_p = fig.add_subplot(gs[1, 0])
-    ax_v = fig.add_subplot(gs[1, 1])
-    ax_j = fig.add_subplot(gs[0:2, 2])
-    ax_qt = fig.add_subplot(gs[2, 0])
-    ax_vt = fig.add_subplot(gs[2, 1])
-    ax_tau = fig.add_subplot(gs[2, 2])
+    ax = {"z": fig.add_subplot(gs[0, 0:2]), "p": fig.add_subplot(gs[1, 0]), "v": fig.add_subplot(gs[1, 1]),
+          "j": fig.add_subplot(gs[0:2, 2]), "qt": fig.add_subplot(gs[2, 0]), "vt": fig.add_subplot(gs[2, 1]),
+          "tau": fig.add_subplot(gs[2, 2])}
+    _plot_base(ax, args, report, traces, segs)
+    _plot_left_leg(ax, traces, slopes, verts)
+    for a in ax.values():
+        a.grid(alpha=0.3)
+    fig.suptitle(f"Blind walking over '{args.terrain}' at {args.speed} m/s, $z_B^{{ref}}$ = {args.height} m", fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+def _plot_base(ax, args, report, traces, segs):
+    """(a): height over the course with its segments, pitch and forward speed of each run."""
+    ax_z, ax_p, ax_v = ax["z"], ax["p"], ax["v"]
     xs = [segs[0][1] - 1.0] + [s[1] for s in segs] + [segs[-1][2], segs[-1][2] + 1.0]
     ax_z.plot(xs, [ground_at(segs, x) for x in xs], color="k", lw=1, label="ground (rough: nominal)")
     for t, x0, x1, *_ in segs:
@@ -216,7 +203,12 @@ def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
     ax_v.set_xlabel("time [s]")
     ax_v.set_ylabel("xd [m/s]")
     _legend(ax_v, fontsize=7)
-    # (b) the left leg on the up-slope
+
+
+def _plot_left_leg(ax, traces, slopes, verts):
+    """(b): the left leg on the up-slope in the joint space with the hexagon, and for the MFT run (or the first)
+    its hip angles, its MFT violation and its hip torques over time."""
+    ax_j, ax_qt, ax_vt, ax_tau = ax["j"], ax["qt"], ax["vt"], ax["tau"]
     vx = [v[0] for v in verts] + [verts[0][0]]
     vy = [v[1] for v in verts] + [verts[0][1]]
     ax_j.fill(vx, vy, color="tab:green", alpha=0.15, label="MFT preferable space (hexagon)")
@@ -235,9 +227,9 @@ def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
             t = [q["time_s"][i] for i in on]
             ax_qt.plot(t, [q["q8"][i] for i in on], color="tab:purple", lw=1, label="$q_8$ (rear hip)")
             ax_qt.plot(t, [q["q10"][i] for i in on], color="tab:brown", lw=1, label="$q_{10}$ (fore hip)")
-            viol = [violation(rows, b, q["q8"][i], q["q10"][i]) for i in on]
+            viol = [tr["mft"]["mft_violation_left"][i] for i in on]
             ax_vt.plot(t, viol, color="0.6", lw=0.8, label="swing")
-            ax_vt.plot([q["time_s"][i] for i in st], [violation(rows, b, q["q8"][i], q["q10"][i]) for i in st], ".",
+            ax_vt.plot([q["time_s"][i] for i in st], [tr["mft"]["mft_violation_left"][i] for i in st], ".",
                        ms=2, color=COLORS.get(c), label="stance")
             tau = tr["joint_tau_cmd"]
             ti = [k for k, tt in enumerate(tau["time_s"]) if t[0] <= tt <= t[-1]]
@@ -259,10 +251,3 @@ def plot_terrain(path, args, report, traces, segs, slopes, rows, b, verts):
     ax_tau.set_xlabel("time [s]")
     ax_tau.set_ylabel("[N m]")
     _legend(ax_tau, fontsize=7)
-    for ax in (ax_z, ax_p, ax_v, ax_j, ax_qt, ax_vt, ax_tau):
-        ax.grid(alpha=0.3)
-    fig.suptitle(f"Blind walking over '{args.terrain}' at {args.speed} m/s, $z_B^{{ref}}$ = {args.height} m", fontsize=11)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path

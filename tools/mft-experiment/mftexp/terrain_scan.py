@@ -20,7 +20,8 @@ from pathlib import Path
 
 from .common import (CONTROLLER_NAMES, ExperimentError, Progress, pyplot, run_closedloop, run_workers,
                      write_report, write_yaml_scenario)
-from .terrain import course_profiles, course_segments, load_yaml, walk_scenario
+from .common import load_yaml
+from .terrain import course_profiles, course_segments, walk_scenario
 
 CLEARANCE_M = 0.3  # "past" an obstacle: the base this far beyond its far edge, the whole robot over it
 
@@ -77,7 +78,8 @@ def judge(run, board_end, course_end, offset):
     return crossed, (not run["fell"]) and x >= course_end + offset + CLEARANCE_M
 
 
-def cmd_terrain_scan(args):
+def _course(args):
+    """The terrain file's segments: (segments, board start, board end, the last obstacle's far edge), unshifted."""
     tfile = Path(args.config_dir) / "terrain" / f"{args.terrain}.yaml"
     if not tfile.is_file():
         raise ExperimentError(f"terrain file {tfile} does not exist")
@@ -87,18 +89,11 @@ def cmd_terrain_scan(args):
         raise ExperimentError(f"{tfile} has no board, slope or rough segment")
     boards = [s for s in segs if s[0] == "board"]
     board_start, board_end = (boards[0][1], boards[0][2]) if boards else (None, None)
-    course_end = obstacles[-1][2]  # the last obstacle's far edge, unshifted
-    if not 0 < args.shift_step <= args.shift_span:
-        raise ExperimentError("need 0 < --shift-step <= --shift-span")
-    if args.shift_span / args.shift_step > 200:
-        raise ExperimentError("at most 401 offsets (--shift-span / --shift-step <= 200)")
-    args.profile = course_profiles(args)
-    out = Path(args.out)
-    shifts = offsets(args.shift_span, args.shift_step)
-    cells = [(h, v, c) for h in args.heights for v in args.speeds for c in args.controllers]
-    t0 = time.monotonic()
-    configs = {o: shifted_config(Path(args.config_dir), out / "config-shifts" / f"shift{o:+.3f}", args.terrain, o)
-               for o in shifts}
+    return segs, board_start, board_end, obstacles[-1][2]
+
+
+def _scan_jobs(args, out, cells, shifts, course_end):
+    """One scenario per cell (long enough to pass the course at half the commanded speed), one run per offset."""
     jobs = []
     for h, v, c in cells:
         duration = args.duration or min(300.0, round(2.0 + (course_end + CLEARANCE_M + max(shifts)) / (0.5 * v) + 3.0, 1))
@@ -106,41 +101,44 @@ def cmd_terrain_scan(args):
         scen.parent.mkdir(parents=True, exist_ok=True)
         write_yaml_scenario(scen, walk_scenario(h, v, c, args.terrain, duration, f"terrain-scan-{c}", "terrain-scan"))
         jobs += [(h, v, c, o, scen) for o in shifts]
-    progress = Progress(args.workers, quiet=args.quiet)
-    progress.note(f"{len(jobs)} runs: {len(cells)} cells x {len(shifts)} course offsets, {args.workers} at a time, "
-                  f"profiles {args.profile or 'none (the paper setup)'}")
-    left = [len(jobs)]
+    return jobs
 
-    def one(job):
-        h, v, c, o, scen = job
-        sim, wall = run_closedloop(scen, args.bin_dir, configs[o], timeout_s=600.0, profiles=args.profile)
-        crossed, traversed = judge(sim, board_end, course_end, o)
-        contact = sim.get("first_body_contact") or {}
-        row = {"height_m": h, "speed_mps": v, "controller": c, "offset_m": o, "crossed_board": crossed,
-               "traversed": traversed, "fell": sim["fell"], "fall_time_s": sim["fall_time_s"],
-               "max_base_x_m": round(sim["max_base_x_m"], 4),
-               "first_body_contact": contact.get("body"),
-               "contact_x_from_board_m": (None if contact.get("x_m") is None or board_start is None
-                                          else round(contact["x_m"] - (board_start + o), 4)),
-               "contact_time_s": contact.get("time_s")}
-        left[0] -= 1
-        progress.run_finished(wall, f"{h:.2f} m {v:.2f} m/s {c} offset {o:+.3f} m: "
-                                    f"{'traversed' if traversed else 'crossed the board' if crossed else 'failed'}",
-                              left[0])
-        return row
 
-    def flat_height(cell):
-        """The base's mean height walking on flat ground (2-8 s), the cell's setup otherwise: what shapes the legs
-        when they reach the board (with the paper's contact-force weight it sits below the command,
-        docs/profiles.md)."""
-        h, v, c = cell
-        scen = out / "scenarios" / f"flat-h{h:.3f}-v{v:.3f}-{c}.yaml"
-        write_yaml_scenario(scen, walk_scenario(h, v, c, "flat", 8.0, f"terrain-scan-flat-{c}", "terrain-scan"))
-        sim, _ = run_closedloop(scen, args.bin_dir, args.config_dir, timeout_s=120.0, profiles=args.profile)
-        z = sim.get("mean_base_z_m")
-        return None if sim["fell"] or z is None else round(z, 4)
-    flat = dict(zip(cells, run_all(flat_height, cells, args.workers)))
-    rows = run_all(one, jobs, args.workers)
+def _scan_run(args, job, configs, course, progress, left):
+    """One run on its shifted course, judged on that course: the row of terrain_scan.csv."""
+    _, board_start, board_end, course_end = course
+    h, v, c, o, scen = job
+    sim, wall = run_closedloop(scen, args.bin_dir, configs[o], timeout_s=600.0, profiles=args.profile)
+    crossed, traversed = judge(sim, board_end, course_end, o)
+    contact = sim.get("first_body_contact") or {}
+    row = {"height_m": h, "speed_mps": v, "controller": c, "offset_m": o, "crossed_board": crossed,
+           "traversed": traversed, "fell": sim["fell"], "fall_time_s": sim["fall_time_s"],
+           "max_base_x_m": round(sim["max_base_x_m"], 4),
+           "first_body_contact": contact.get("body"),
+           "contact_x_from_board_m": (None if contact.get("x_m") is None or board_start is None
+                                      else round(contact["x_m"] - (board_start + o), 4)),
+           "contact_time_s": contact.get("time_s")}
+    left[0] -= 1
+    progress.run_finished(wall, f"{h:.2f} m {v:.2f} m/s {c} offset {o:+.3f} m: "
+                                f"{'traversed' if traversed else 'crossed the board' if crossed else 'failed'}",
+                          left[0])
+    return row
+
+
+def _flat_height(args, out, cell):
+    """The base's mean height walking on flat ground (2-8 s), the cell's setup otherwise: what shapes the legs
+    when they reach the board (with the paper's contact-force weight it sits below the command,
+    docs/profiles.md)."""
+    h, v, c = cell
+    scen = out / "scenarios" / f"flat-h{h:.3f}-v{v:.3f}-{c}.yaml"
+    write_yaml_scenario(scen, walk_scenario(h, v, c, "flat", 8.0, f"terrain-scan-flat-{c}", "terrain-scan"))
+    sim, _ = run_closedloop(scen, args.bin_dir, args.config_dir, timeout_s=120.0, profiles=args.profile)
+    z = sim.get("mean_base_z_m")
+    return None if sim["fell"] or z is None else round(z, 4)
+
+
+def _cell_summary(cells, rows, flat):
+    """Per cell: how many runs crossed the board and traversed the course, and what failed runs hit first."""
     summary = []
     for h, v, c in cells:
         rs = [r for r in rows if (r["height_m"], r["speed_mps"], r["controller"]) == (h, v, c)]
@@ -154,8 +152,31 @@ def cmd_terrain_scan(args):
                         "traversed": sum(r["traversed"] for r in rs),
                         "traversed_of_crossed": sum(r["traversed"] for r in rs if r["crossed_board"]),
                         "failed_first_body_contact": bodies})
+    return summary
+
+
+def cmd_terrain_scan(args):
+    course = _course(args)
+    if not 0 < args.shift_step <= args.shift_span:
+        raise ExperimentError("need 0 < --shift-step <= --shift-span")
+    if args.shift_span / args.shift_step > 200:
+        raise ExperimentError("at most 401 offsets (--shift-span / --shift-step <= 200)")
+    args.profile = course_profiles(args)
+    out = Path(args.out)
+    shifts = offsets(args.shift_span, args.shift_step)
+    cells = [(h, v, c) for h in args.heights for v in args.speeds for c in args.controllers]
+    t0 = time.monotonic()
+    configs = {o: shifted_config(Path(args.config_dir), out / "config-shifts" / f"shift{o:+.3f}", args.terrain, o)
+               for o in shifts}
+    jobs = _scan_jobs(args, out, cells, shifts, course[3])
+    progress = Progress(args.workers, quiet=args.quiet)
+    progress.note(f"{len(jobs)} runs: {len(cells)} cells x {len(shifts)} course offsets, {args.workers} at a time, "
+                  f"profiles {args.profile or 'none (the paper setup)'}")
+    left = [len(jobs)]
+    flat = dict(zip(cells, run_all(lambda cell: _flat_height(args, out, cell), cells, args.workers)))
+    rows = run_all(lambda job: _scan_run(args, job, configs, course, progress, left), jobs, args.workers)
     report = {"terrain": args.terrain, "profiles": list(args.profile), "offsets_m": shifts,
-              "clearance_m": CLEARANCE_M, "cells": summary, "runs": rows, "out": str(out)}
+              "clearance_m": CLEARANCE_M, "cells": _cell_summary(cells, rows, flat), "runs": rows, "out": str(out)}
     write_tables(out, report)
     png = plot_scan(out / "terrain_scan.png", report)
     write_report(out / "terrain_scan.json", report, png, t0, args.json)

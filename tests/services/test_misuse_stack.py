@@ -65,6 +65,31 @@ class MisuseStackTest(StackTestCase):
         self.assertEqual(before["services"], after["services"])  # the running stack was not disturbed
         self.assertTrue(all(s["alive"] for s in after["services"].values()), after)
 
+    def test_kill_9_of_the_supervisor_closes_the_recording_and_the_next_start_removes_the_segment(self):
+        # The recorder gets SIGTERM when its supervisor dies (the other services SIGKILL): the sidecar said
+        # "status: recording" for good. The chain segment of a realtime stack outlived it: the next start removes it.
+        domain = DOMAIN_BASE + 1
+        rawlog = self.tmp / "killed.rawlog"
+        r = self.sup("up", SCENARIOS / "stand.yaml", "--domain", domain, "--mode", "realtime", "--no-rt",
+                     "--record", rawlog)
+        self.up_domains.append((domain, self.env))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        st = json.loads(self.sup("status", "--domain", domain, "--json").stdout)
+        segments = [n for n in os.listdir("/dev/shm") if n.startswith(f"mft-chain-d{domain}-{st['supervisor_pid']}-")]
+        self.assertEqual(len(segments), 1, os.listdir("/dev/shm"))
+        time.sleep(1.0)
+        os.kill(st["supervisor_pid"], signal.SIGKILL)
+        sidecar = Path(str(rawlog) + ".yaml")
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and "status: complete" not in (sidecar.read_text() if sidecar.exists() else ""):
+            time.sleep(0.1)
+        self.assertIn("status: complete", sidecar.read_text()[-300:])  # the recording section is last
+        self.assertTrue((Path("/dev/shm") / segments[0]).exists())  # nobody left to remove it ...
+        r = self.sup("run", SCENARIOS / "stand.yaml", "--domain", domain + 1, "--run-dir", self.tmp / "next")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn(f"removed /dev/shm/{segments[0]}: its supervisor is gone", r.stderr)
+        self.assertFalse((Path("/dev/shm") / segments[0]).exists())  # ... until the next start
+
     def test_the_chain_channel_refuses_secure_and_bad_names_and_leaves_nothing_in_dev_shm(self):
         base = [str(BIN / "mft-estimator"), "--domain", str(DOMAIN_BASE + 2), "--scenario", str(SCENARIOS / "stand.yaml")]
         for extra, message in ((["--chain-shm", "/mft-chain-x", "--secure", str(self.tmp)], "not with --secure"),

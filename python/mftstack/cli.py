@@ -261,7 +261,7 @@ def cmd_status(args):
     out = {"domain": args.domain, "supervisor_pid": st["supervisor_pid"], "supervisor_alive": pid_alive(st["supervisor_pid"]),
            "scenario": st["scenario"], "mode": st["mode"], "run_dir": st["run_dir"], "services": services,
            "uptime_s": round(time.time() - st["started"], 1), "stack": st.get("stack"),
-           "live_changes": live_changes(Path(st["run_dir"]))}
+           "live_changes": live_changes(Path(st["run_dir"])), "warnings": run_dir_warnings(Path(st["run_dir"]))}
     if args.json:
         print(json.dumps(out, indent=2))
     else:
@@ -276,7 +276,26 @@ def cmd_status(args):
             for c in changes:
                 print(f"  live change    {n}: {c['key']} = {c['value']} (was {c['previous']}) from tick {c['tick']} "
                       f"(t = {c['time_s']:.3f} s), seq {c['seq']}")
+        for w in out["warnings"]:
+            print(f"  warning: {w}")
     return 0 if out["supervisor_alive"] else 1
+
+
+RUN_DIR_FULL_BYTES = 64 * 1024  # less free than this: a service's next log line or tuning file may not fit
+
+
+def run_dir_warnings(run_dir):
+    """What status cannot vouch for: on a full disk the services cannot write their live-change lists
+    (*.tuning.json) or logs, so an empty list would read as "no live changes"."""
+    try:
+        st = os.statvfs(run_dir)
+    except OSError as e:
+        return [f"cannot inspect the run folder {run_dir}: {e.strerror}"]
+    free = st.f_bavail * st.f_frsize
+    if free < RUN_DIR_FULL_BYTES:
+        return [f"the run folder's disk is full ({free // 1024} kB free): live changes, logs and summaries written "
+                "since may be missing"]
+    return []
 
 
 def live_changes(run_dir):

@@ -5,6 +5,7 @@ readiness and clean end, restart with back-off in realtime, a crash failing a lo
 import argparse
 import json
 import os
+import shlex
 import shutil
 import signal
 import subprocess
@@ -494,6 +495,27 @@ class MisuseTest(FakeStack, unittest.TestCase):
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assert_one_line_error(r.stderr, f"cannot write the run folder {ro / 'run'}: Read-only file system")
         self.assertEqual(self.started_pids(), [])
+
+    @unittest.skipUnless(os.geteuid() == 0 and shutil.which("unshare"), "needs root and unshare (mount namespace)")
+    def test_status_warns_when_the_run_folder_is_full(self):
+        # status listed no live changes on a full run folder and said nothing: the services could not write them.
+        disk = self.tmp / "disk"
+        disk.mkdir()
+        sup = " ".join(shlex.quote(str(a)) for a in [sys.executable, SUPERVISOR])
+        up = " ".join(shlex.quote(a) for a in self.sup_cmd("up", self.scenario, "--domain", "26", "--mode", "realtime",
+                                                           "--run-dir", disk / "run"))
+        script = (f"{up} >/dev/null 2>&1; {sup} status --domain 26 --json > {self.tmp / 'before.json'}; "
+                  f"dd if=/dev/zero of={disk / 'fill'} bs=4k >/dev/null 2>&1; "
+                  f"{sup} status --domain 26 --json > {self.tmp / 'after.json'}; {sup} status --domain 26; "
+                  f"{sup} down --domain 26 >/dev/null 2>&1")
+        r = self.in_private_mounts([f"mount -t tmpfs -o size=256k tmpfs {disk}"], ["sh", "-c", script],
+                                   dict(self.env, FAKE_SERVICES=""))
+        before = json.loads((self.tmp / "before.json").read_text())
+        after = json.loads((self.tmp / "after.json").read_text())
+        self.assertEqual(before["warnings"], [])
+        self.assertEqual(len(after["warnings"]), 1, after)
+        self.assertRegex(after["warnings"][0], r"^the run folder's disk is full \(0 kB free\): live changes, logs")
+        self.assertIn("  warning: the run folder's disk is full", r.stdout)
 
     @unittest.skipUnless(os.geteuid() == 0 and shutil.which("unshare"), "needs root and unshare (mount namespace)")
     def test_a_full_disk_never_loses_the_result(self):

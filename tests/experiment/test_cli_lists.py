@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """mft-experiment's list options (--heights, --speeds): a value given twice is refused (it ran twice and filled
-one table cell), as are values outside the planner's ranges and text that is not a number."""
+one table cell), as are values outside the planner's ranges and text that is not a number; a failed in-process
+run reports the tool's reason, not its --help hint."""
 import argparse
 import sys
 import unittest
@@ -28,6 +29,18 @@ class ListOptionsTest(unittest.TestCase):
         self.assertIn("outside the planner's window", self.refusal(cli.heights_list, "0.9"))
         self.assertIn("not a comma-separated list", self.refusal(cli.heights_list, "0.4,x"))
         self.assertIn("outside the planner's window", self.refusal(cli.heights_list, "nan"))
+
+
+class ToolReasonTest(unittest.TestCase):
+    """mft-experiment --inprocess with a bad config showed "Try 'mft-closedloop --help'." instead of the reason."""
+
+    def test_the_reason_not_the_help_hint(self):
+        from mftexp import common
+        err = "mft-closedloop: planner.yaml: swing.lift_height_m: must lie in [0, 0.3] m (got 50)\n" \
+              "Try 'mft-closedloop --help'.\n"
+        self.assertEqual(common.tool_reason(err),
+                         "mft-closedloop: planner.yaml: swing.lift_height_m: must lie in [0, 0.3] m (got 50)")
+        self.assertEqual(common.tool_reason(""), "no output")
 
 
 if __name__ == "__main__":

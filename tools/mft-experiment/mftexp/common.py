@@ -234,6 +234,12 @@ def run_scenario(scenario_path, run_dir, domain, bin_dir, config_dir, record=Non
     return summary, wall
 
 
+def tool_reason(stderr):
+    """The reason a tool printed: its last line other than the "Try 'TOOL --help'." hint after a usage error."""
+    lines = [l for l in stderr.strip().splitlines() if l.strip() and not l.startswith("Try '")]
+    return lines[-1] if lines else "no output"
+
+
 def run_closedloop(scenario_path, bin_dir, config_dir, timeout_s=600.0, profiles=()):
     """One run of the in-process loop (mft-closedloop --scenario, same configs, profiles and recovery verdict as
     the stack). Returns (a dict shaped like mft-sim's summary: fell, fall_time_s, fall_reason, recovery, ...;
@@ -253,8 +259,7 @@ def run_closedloop(scenario_path, bin_dir, config_dir, timeout_s=600.0, profiles
     if REGISTRY.stopping.is_set():
         raise Interrupted()
     if p.returncode not in (0, 1):
-        raise ExperimentError(f"mft-closedloop failed on {scenario_path} (status {p.returncode}): "
-                              f"{(err.strip().splitlines() or ['no output'])[-1]}")
+        raise ExperimentError(f"mft-closedloop failed on {scenario_path} (status {p.returncode}): {tool_reason(err)}")
     try:
         d = json.loads(out)
     except ValueError:

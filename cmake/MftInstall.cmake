@@ -64,6 +64,8 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/ DESTINATION ${MFT_INSTALL_DATADI
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/tools/mft-export/mft-plot.py ${PROJECT_SOURCE_DIR}/tools/mft-export/mft-video.py
                  ${PROJECT_SOURCE_DIR}/tools/mft-space/mft_space_figure.py
         DESTINATION ${MFT_INSTALL_DATADIR}/scripts COMPONENT runtime)
+install(FILES ${PROJECT_SOURCE_DIR}/tools/mft-export/mft_video_panel.py  # imported by mft-video.py from beside it
+        DESTINATION ${MFT_INSTALL_DATADIR}/scripts COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/python/mftstack DESTINATION ${MFT_INSTALL_DATADIR}/python COMPONENT runtime
         PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/services/mft-supervisor DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)

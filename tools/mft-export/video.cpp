@@ -329,25 +329,32 @@ std::string shellQuote(const std::string& s) {
   return out + "'";
 }
 
-}  // namespace
+// What --video asks for, checked before anything is read.
+struct VideoRequest {
+  std::string out, ext, ffmpeg;
+  double speed = 1.0, from = 0.0, to = INFINITY;
+  long fps = 30;
+};
 
-int videoMain(const services::CommandLine& cli, const std::string& file) {
-  const std::string out = cli.get("video");
-  const std::string ext = lowerExtension(out);
-  if (ext != ".mp4" && ext != ".gif") cli.fail("--video: " + out + " must end in .mp4 or .gif");
+// The options of --video (a bad one is a usage error); 0, or the exit status when a tool is missing.
+int videoRequest(const services::CommandLine& cli, VideoRequest* r) {
+  r->out = cli.get("video");
+  r->ext = lowerExtension(r->out);
+  if (r->ext != ".mp4" && r->ext != ".gif") cli.fail("--video: " + r->out + " must end in .mp4 or .gif");
   for (const char* other : {"csv", "plot", "info", "labels"})
     if (cli.isSet(other)) cli.fail(std::string("--video cannot be combined with --") + other);
-  const double speed = cli.isSet("speed") ? cli.getDouble("speed", 0.01, 1000.0) : 1.0;
-  const long fps = cli.isSet("fps") ? cli.getInt("fps", 1, 120) : (ext == ".gif" ? 15 : 30);
-  const double from = cli.isSet("from") ? cli.getDouble("from", 0.0, 1e7) : 0.0;
-  const double to = cli.isSet("to") ? cli.getDouble("to", 0.0, 1e7) : INFINITY;
-  if (!(to > from)) cli.fail("--to must be after --from (got --from " + cli.get("from") + " --to " + cli.get("to") + ")");
+  r->speed = cli.isSet("speed") ? cli.getDouble("speed", 0.01, 1000.0) : 1.0;
+  r->fps = cli.isSet("fps") ? cli.getInt("fps", 1, 120) : (r->ext == ".gif" ? 15 : 30);
+  r->from = cli.isSet("from") ? cli.getDouble("from", 0.0, 1e7) : 0.0;
+  r->to = cli.isSet("to") ? cli.getDouble("to", 0.0, 1e7) : INFINITY;
+  if (!(r->to > r->from))
+    cli.fail("--to must be after --from (got --from " + cli.get("from") + " --to " + cli.get("to") + ")");
   std::error_code ec;
-  if (fs::is_directory(out, ec)) cli.fail("--video: " + out + " is a directory");
-  if (fs::exists(out, ec) && !cli.isSet("overwrite"))
-    cli.fail("--video: " + out + " already exists: refusing to replace it (--overwrite replaces it)");
-  const std::string ffmpeg = findOnPath("ffmpeg");
-  if (ffmpeg.empty()) {
+  if (fs::is_directory(r->out, ec)) cli.fail("--video: " + r->out + " is a directory");
+  if (fs::exists(r->out, ec) && !cli.isSet("overwrite"))
+    cli.fail("--video: " + r->out + " already exists: refusing to replace it (--overwrite replaces it)");
+  r->ffmpeg = findOnPath("ffmpeg");
+  if (r->ffmpeg.empty()) {
     std::fprintf(stderr, "mft-export: --video needs ffmpeg, which is not on PATH (Debian: apt-get install ffmpeg)\n");
     return kExitBadInput;
   }
@@ -356,49 +363,143 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
                          "python3-matplotlib)\n");
     return kExitBadInput;
   }
+  return 0;
+}
 
-  std::vector<std::unique_ptr<Panel>> panels;
+// The recording (and --beside's) opened; 0, or the exit status. Sets the longest expected duration.
+int openPanels(const services::CommandLine& cli, const std::string& file, const VideoRequest& r,
+               std::vector<std::unique_ptr<Panel>>* panels, double* expected_end) {
   std::vector<std::string> warnings;
-  panels.push_back(std::make_unique<Panel>(file));
-  if (cli.isSet("beside")) panels.push_back(std::make_unique<Panel>(cli.get("beside")));
-  for (auto& p : panels) {
+  panels->push_back(std::make_unique<Panel>(file));
+  if (cli.isSet("beside")) panels->push_back(std::make_unique<Panel>(cli.get("beside")));
+  for (auto& p : *panels) {
     std::string error;
     if (!p->open(&error, &warnings)) {
       std::fprintf(stderr, "mft-export: %s\n", error.c_str());
       return kExitBadInput;
     }
   }
-  double expected_end = 0.0;
-  for (const auto& p : panels) expected_end = std::max(expected_end, p->expectedDuration());
-  if (expected_end > 0.0 && from >= expected_end)
-    cli.fail("--from " + cli.get("from") + " s is not before the end of the run (" + seconds(expected_end) + ")");
+  *expected_end = 0.0;
+  for (const auto& p : *panels) *expected_end = std::max(*expected_end, p->expectedDuration());
+  if (*expected_end > 0.0 && r.from >= *expected_end)
+    cli.fail("--from " + cli.get("from") + " s is not before the end of the run (" + seconds(*expected_end) + ")");
   for (const auto& w : warnings) std::fprintf(stderr, "mft-export: warning: %s\n", w.c_str());
+  return 0;
+}
+
+// The renderer's first line: the output, the clock and the panels.
+std::string headerLine(const services::CommandLine& cli, const VideoRequest& r, const std::string& tmp,
+                       const std::vector<std::unique_ptr<Panel>>& panels, double expected_end) {
+  const double frame_dt = r.speed / static_cast<double>(r.fps);
+  const double end_for_estimate = std::min(r.to, expected_end);
+  // A recording of D s holds samples up to D - 1 ms: frames at from + i dt for from + i dt < D.
+  const long frames_expected =
+      end_for_estimate > r.from ? static_cast<long>(std::ceil((end_for_estimate - r.from) / frame_dt - 1e-6)) : 0;
+  config::JsonWriter header_json;
+  header_json.beginObject().field("type", "header").field("output", tmp).field("final_output", r.out);
+  header_json.field("format", r.ext.substr(1)).field("ffmpeg", r.ffmpeg).field("fps", r.fps).field("speed", r.speed, kPosition);
+  header_json.field("from_s", r.from, kPosition).field("frames_expected", frames_expected);
+  header_json.field("frame_log", cli.get("frame-log")).key("panels").beginArray();
+  for (const auto& p : panels) header_json.raw(p->headerJson());
+  return header_json.endArray().endObject().str() + "\n";
+}
+
+struct Rendered {
+  long frames = 0;
+  double last_t = 0.0, wall_s = 0.0;
+  bool interrupted = false;
+  int rc = 0;  // the renderer's exit status
+};
+
+// Frames at from + i dt while any recording still has data at that time (one that ended shows its last state),
+// one JSON line each into the renderer.
+Rendered renderFrames(const std::string& header, const VideoRequest& r, std::vector<std::unique_ptr<Panel>>& panels,
+                      std::FILE* renderer) {
+  const double frame_dt = r.speed / static_cast<double>(r.fps);
+  const auto t0 = std::chrono::steady_clock::now();
+  Rendered out;
+  out.last_t = r.from;
+  bool write_failed = std::fputs(header.c_str(), renderer) < 0;
+  while (!write_failed) {
+    if (services::shutdownRequested()) {
+      out.interrupted = true;
+      break;
+    }
+    const double t = r.from + static_cast<double>(out.frames) * frame_dt;
+    if (t >= r.to - 1e-9) break;  // frames cover [from, to): the video lasts (to - from) / speed
+    bool any_running = false;
+    for (auto& p : panels) {
+      p->advanceTo(t);
+      any_running = any_running || (p->hasSample() && p->sampleTime() >= t - 1e-9);
+    }
+    if (!any_running) break;
+    config::JsonWriter frame;
+    frame.beginObject().field("type", "frame").field("i", out.frames).key("panels").beginArray();
+    for (const auto& p : panels) frame.raw(p->frameJson(t));
+    const std::string line = frame.endArray().endObject().str() + "\n";
+    write_failed = std::fputs(line.c_str(), renderer) < 0;
+    out.last_t = t;
+    ++out.frames;
+  }
+  const int status = ::pclose(renderer);
+  out.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.rc = status == -1 ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return out;
+}
+
+// The finished video's line (or JSON), the recordings' truncation or damage; the exit status.
+int reportVideo(const services::CommandLine& cli, const VideoRequest& r, const Rendered& v,
+                const std::vector<std::unique_ptr<Panel>>& panels) {
+  bool corrupt = false;
+  for (const auto& p : panels) {
+    if (p->reader().end() == rawlog::RawlogReader::End::Truncated)
+      std::fprintf(stderr, "mft-export: %s is truncated: drawn up to its last whole record\n", p->path().c_str());
+    if (p->reader().end() == rawlog::RawlogReader::End::Corrupt) {
+      std::fprintf(stderr, "mft-export: %s is %s: drawn up to the damage\n", p->path().c_str(), p->reader().endMessage().c_str());
+      corrupt = true;
+    }
+  }
+  const double video_s = static_cast<double>(v.frames) / static_cast<double>(r.fps);
+  const double bytes = static_cast<double>(fs::file_size(r.out));
+  const double rate = static_cast<double>(v.frames) / std::max(v.wall_s, 1e-9);
+  if (cli.isSet("json")) {
+    config::JsonWriter w;
+    w.beginObject().field("video", r.out).field("format", r.ext.substr(1)).field("frames", v.frames).field("fps", r.fps);
+    w.field("speed", r.speed, kPosition).fixedField("from_s", r.from, 6).fixedField("last_frame_s", v.last_t, 6);
+    w.fixedField("video_s", video_s, 6).field("panels", panels.size()).fixedField("bytes", bytes, 0);
+    w.fixedField("wall_s", v.wall_s, 3).fixedField("frames_per_s", rate, 2);
+    std::printf("%s\n", w.endObject().str().c_str());
+  } else {
+    std::printf("video      %s: %ld frames at %ld fps = %.2f s of video for %.3f-%.3f s of the run (x%g), %zu panel%s, "
+                "%.2f MB, rendered in %.1f s (%.1f frames/s)\n",
+                r.out.c_str(), v.frames, r.fps, video_s, r.from, v.last_t + r.speed / static_cast<double>(r.fps), r.speed,
+                panels.size(), panels.size() > 1 ? "s" : "", bytes / 1e6, v.wall_s, rate);
+  }
+  return corrupt ? kExitCorrupt : 0;
+}
+
+}  // namespace
+
+int videoMain(const services::CommandLine& cli, const std::string& file) {
+  VideoRequest r;
+  if (const int rc = videoRequest(cli, &r)) return rc;
+  std::vector<std::unique_ptr<Panel>> panels;
+  double expected_end = 0.0;
+  if (const int rc = openPanels(cli, file, r, &panels, &expected_end)) return rc;
 
   // Written under a temporary name in the same folder and renamed when complete: an interrupted or failed
   // render never leaves a partial video under the requested name.
-  const fs::path out_path(out);
+  const fs::path out_path(r.out);
   const fs::path dir = out_path.has_parent_path() ? out_path.parent_path() : fs::path(".");
   const std::string tmp = (dir / ("." + out_path.filename().string() + ".partial-" + std::to_string(::getpid()))).string();
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
   if (fd < 0) {
-    std::fprintf(stderr, "mft-export: cannot write %s: %s\n", out.c_str(), std::strerror(errno));
+    std::fprintf(stderr, "mft-export: cannot write %s: %s\n", r.out.c_str(), std::strerror(errno));
     return kExitBadInput;
   }
   ::close(fd);
   auto removeTmp = [&] { ::unlink(tmp.c_str()); };
-
-  const double frame_dt = speed / static_cast<double>(fps);
-  const double end_for_estimate = std::min(to, expected_end);
-  // A recording of D s holds samples up to D - 1 ms: frames at from + i dt for from + i dt < D.
-  const long frames_expected =
-      end_for_estimate > from ? static_cast<long>(std::ceil((end_for_estimate - from) / frame_dt - 1e-6)) : 0;
-  config::JsonWriter header_json;
-  header_json.beginObject().field("type", "header").field("output", tmp).field("final_output", out);
-  header_json.field("format", ext.substr(1)).field("ffmpeg", ffmpeg).field("fps", fps).field("speed", speed, kPosition);
-  header_json.field("from_s", from, kPosition).field("frames_expected", frames_expected);
-  header_json.field("frame_log", cli.get("frame-log")).key("panels").beginArray();
-  for (const auto& p : panels) header_json.raw(p->headerJson());
-  const std::string header = header_json.endArray().endObject().str() + "\n";
+  const std::string header = headerLine(cli, r, tmp, panels, expected_end);
 
   // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/videos.md).
   std::signal(SIGPIPE, SIG_IGN);  // a renderer that died shows as a failed write, not as our death
@@ -411,86 +512,33 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
     std::fprintf(stderr, "mft-export: cannot start the renderer (%s): %s\n", cmd.c_str(), std::strerror(errno));
     return kExitBadInput;
   }
-  const auto t0 = std::chrono::steady_clock::now();
-  bool write_failed = std::fputs(header.c_str(), renderer) < 0;
-  long frames = 0;
-  double last_t = from;
-  bool interrupted = false;
-  while (!write_failed) {
-    if (services::shutdownRequested()) {
-      interrupted = true;
-      break;
-    }
-    const double t = from + static_cast<double>(frames) * frame_dt;
-    if (t >= to - 1e-9) break;  // frames cover [from, to): the video lasts (to - from) / speed
-    bool any_running = false;
-    for (auto& p : panels) {
-      p->advanceTo(t);
-      any_running = any_running || (p->hasSample() && p->sampleTime() >= t - 1e-9);
-    }
-    // Frames go on while any recording still has data at this time; one that ended shows its last state.
-    if (!any_running) break;
-    config::JsonWriter frame;
-    frame.beginObject().field("type", "frame").field("i", frames).key("panels").beginArray();
-    for (const auto& p : panels) frame.raw(p->frameJson(t));
-    const std::string line = frame.endArray().endObject().str() + "\n";
-    write_failed = std::fputs(line.c_str(), renderer) < 0;
-    last_t = t;
-    ++frames;
-  }
-  const int status = ::pclose(renderer);
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const int rc = status == -1 ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  if (interrupted || services::shutdownRequested()) {
+  const Rendered v = renderFrames(header, r, panels, renderer);
+  if (v.interrupted || services::shutdownRequested()) {
     removeTmp();
     std::fprintf(stderr, "mft-export: interrupted: no video written\n");
     return kExitInterrupted;
   }
-  if (rc != 0) {
+  if (v.rc != 0) {
     removeTmp();
     // The renderer said why on stderr (its messages start with "mft-export:").
-    if (rc != kExitBadInput) std::fprintf(stderr, "mft-export: the renderer failed (exit status %d): no video written\n", rc);
+    if (v.rc != kExitBadInput) std::fprintf(stderr, "mft-export: the renderer failed (exit status %d): no video written\n", v.rc);
     return kExitBadInput;
   }
-  if (frames == 0) {
+  if (v.frames == 0) {
     removeTmp();
     double end = 0.0;
     for (const auto& p : panels) end = std::max(end, p->hasSample() ? p->sampleTime() : 0.0);
     cli.fail("--from " + cli.get("from") + " s is not before the end of the recording (" + seconds(end) + ")");
   }
-  const std::string cut = ext == ".mp4" ? incompleteMp4(tmp) : "";
+  const std::string cut = r.ext == ".mp4" ? incompleteMp4(tmp) : "";
   if (!cut.empty()) {
     removeTmp();
     std::fprintf(stderr, "mft-export: the encoder left %s incomplete (%s; disk full?): no video written\n",
-                 out.c_str(), cut.c_str());
+                 r.out.c_str(), cut.c_str());
     return kExitBadInput;
   }
-  fs::rename(tmp, out);
-  bool corrupt = false;
-  for (const auto& p : panels) {
-    if (p->reader().end() == rawlog::RawlogReader::End::Truncated)
-      std::fprintf(stderr, "mft-export: %s is truncated: drawn up to its last whole record\n", p->path().c_str());
-    if (p->reader().end() == rawlog::RawlogReader::End::Corrupt) {
-      std::fprintf(stderr, "mft-export: %s is %s: drawn up to the damage\n", p->path().c_str(), p->reader().endMessage().c_str());
-      corrupt = true;
-    }
-  }
-  const double video_s = static_cast<double>(frames) / static_cast<double>(fps);
-  const double bytes = static_cast<double>(fs::file_size(out));
-  if (cli.isSet("json")) {
-    config::JsonWriter w;
-    w.beginObject().field("video", out).field("format", ext.substr(1)).field("frames", frames).field("fps", fps);
-    w.field("speed", speed, kPosition).fixedField("from_s", from, 6).fixedField("last_frame_s", last_t, 6);
-    w.fixedField("video_s", video_s, 6).field("panels", panels.size()).fixedField("bytes", bytes, 0);
-    w.fixedField("wall_s", wall, 3).fixedField("frames_per_s", static_cast<double>(frames) / std::max(wall, 1e-9), 2);
-    std::printf("%s\n", w.endObject().str().c_str());
-  } else {
-    std::printf("video      %s: %ld frames at %ld fps = %.2f s of video for %.3f-%.3f s of the run (x%g), %zu panel%s, "
-                "%.2f MB, rendered in %.1f s (%.1f frames/s)\n",
-                out.c_str(), frames, fps, video_s, from, last_t + frame_dt, speed, panels.size(), panels.size() > 1 ? "s" : "",
-                bytes / 1e6, wall, static_cast<double>(frames) / std::max(wall, 1e-9));
-  }
-  return corrupt ? kExitCorrupt : 0;
+  fs::rename(tmp, r.out);
+  return reportVideo(cli, r, v, panels);
 }
 
 }  // namespace mft::video

@@ -142,67 +142,83 @@ double clampInfinite(double v) { return std::isinf(v) ? (v > 0 ? 1e308 : -1e308)
 // Solution values at full precision (they round-trip like the instance files).
 constexpr int kExact = 17;
 
-}  // namespace
-
-int runBench(const BenchOptions& o) {
-  const std::vector<QpInstance> instances = loadFolder(o.dir);
-  const std::string notes = prepareProcess(o.cpu);
-  const std::size_t count = instances.size();
-  std::vector<double> best(count, qp::kInf);
+// What a bench pass adds up: the accuracy of the last pass, the times of every pass.
+struct BenchTally {
+  std::vector<double> best;  // per instance: the fastest solve over the passes [us]
   double raw_max = 0.0;
   int failures = 0, fallbacks = 0;
   long long iterations_sum = 0;
   int iterations_max = 0;
   Accuracy worst;
   int steps_mismatched = 0, steps_strict = 0;
+};
 
-  for (int pass = 0; pass < o.passes; ++pass) {
-    // A fresh solver per pass: every pass starts without warm-start state.
-    const qp::QpProblem& first = instances.front().problem;
-    qp::GoldfarbIdnaniSolver solver(first.n, first.neq, first.nin);
-    solver.options().warm_start = o.warm;
-    QpSolution sol;
-    sol.resize(first.n, first.neq, first.nin);
-    for (std::size_t k = 0; k < count; ++k) {
-      // Instances named <run>_<tick> form runs of consecutive ticks: a new run starts without warm-start state.
-      if (k > 0 && runName(instances[k].name) != runName(instances[k - 1].name)) solver.clearWarmStart();
-      const auto t0 = std::chrono::steady_clock::now();
-      const QpStatus st = solver.solve(instances[k].problem, &sol);
-      const auto t1 = std::chrono::steady_clock::now();
-      const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
-      best[k] = std::min(best[k], us);
-      raw_max = std::max(raw_max, us);
-      if (pass != o.passes - 1) continue;
-      // Accuracy from the last pass (every pass solves the same problems the same way).
-      fallbacks += solver.lastSolveFellBack() ? 1 : 0;
-      iterations_sum += sol.iterations;
-      iterations_max = std::max(iterations_max, sol.iterations);
-      std::string why;
-      if (st != QpStatus::Optimal) {
-        ++failures;
-        if (!o.json) std::cerr << instances[k].name << ": " << qp::toString(st) << "\n";
-        continue;
-      }
-      if (!verifiedOptimal(instances[k].problem, sol, qp::kktResiduals(instances[k].problem, sol), &why)) {
-        ++failures;
-        if (!o.json) std::cerr << instances[k].name << ": unverified: " << why << "\n";
-        continue;
-      }
-      const Accuracy a = checkSolution(instances[k], sol);
-      worst.x_err = std::max(worst.x_err, a.x_err);
-      worst.kkt = std::max(worst.kkt, a.kkt);
-      worst.mismatched += a.mismatched;
-      worst.strict_mismatched += a.strict_mismatched;
-      steps_mismatched += a.mismatched ? 1 : 0;
-      steps_strict += a.strict_mismatched ? 1 : 0;
-    }
+// The last pass's verdict on one solve: optimal and verified, then its accuracy against the reference.
+void judgeSolve(const BenchOptions& o, const QpInstance& inst, QpStatus st, const QpSolution& sol, BenchTally* t) {
+  std::string why;
+  if (st != QpStatus::Optimal) {
+    ++t->failures;
+    if (!o.json) std::cerr << inst.name << ": " << qp::toString(st) << "\n";
+    return;
   }
-  std::vector<double> sorted = best;
+  if (!verifiedOptimal(inst.problem, sol, qp::kktResiduals(inst.problem, sol), &why)) {
+    ++t->failures;
+    if (!o.json) std::cerr << inst.name << ": unverified: " << why << "\n";
+    return;
+  }
+  const Accuracy a = checkSolution(inst, sol);
+  t->worst.x_err = std::max(t->worst.x_err, a.x_err);
+  t->worst.kkt = std::max(t->worst.kkt, a.kkt);
+  t->worst.mismatched += a.mismatched;
+  t->worst.strict_mismatched += a.strict_mismatched;
+  t->steps_mismatched += a.mismatched ? 1 : 0;
+  t->steps_strict += a.strict_mismatched ? 1 : 0;
+}
+
+// One pass over every instance with a fresh solver (no warm-start state carried from the previous pass).
+void benchPass(const BenchOptions& o, const std::vector<QpInstance>& instances, bool last, BenchTally* t) {
+  const qp::QpProblem& first = instances.front().problem;
+  qp::GoldfarbIdnaniSolver solver(first.n, first.neq, first.nin);
+  solver.options().warm_start = o.warm;
+  QpSolution sol;
+  sol.resize(first.n, first.neq, first.nin);
+  for (std::size_t k = 0; k < instances.size(); ++k) {
+    // Instances named <run>_<tick> form runs of consecutive ticks: a new run starts without warm-start state.
+    if (k > 0 && runName(instances[k].name) != runName(instances[k - 1].name)) solver.clearWarmStart();
+    const auto t0 = std::chrono::steady_clock::now();
+    const QpStatus st = solver.solve(instances[k].problem, &sol);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double us = std::chrono::duration<double, std::micro>(t1 - t0).count();
+    t->best[k] = std::min(t->best[k], us);
+    t->raw_max = std::max(t->raw_max, us);
+    if (!last) continue;
+    // Accuracy from the last pass (every pass solves the same problems the same way).
+    t->fallbacks += solver.lastSolveFellBack() ? 1 : 0;
+    t->iterations_sum += sol.iterations;
+    t->iterations_max = std::max(t->iterations_max, sol.iterations);
+    judgeSolve(o, instances[k], st, sol, t);
+  }
+}
+
+}  // namespace
+
+int runBench(const BenchOptions& o) {
+  const std::vector<QpInstance> instances = loadFolder(o.dir);
+  const std::string notes = prepareProcess(o.cpu);
+  const std::size_t count = instances.size();
+  BenchTally t;
+  t.best.assign(count, qp::kInf);
+  for (int pass = 0; pass < o.passes; ++pass) benchPass(o, instances, pass == o.passes - 1, &t);
+  std::vector<double> sorted = t.best;
   std::sort(sorted.begin(), sorted.end());
   double sum = 0.0;
   for (double v : sorted) sum += v;
   const double mean = sum / static_cast<double>(count);
-  const double iter_mean = static_cast<double>(iterations_sum) / static_cast<double>(count);
+  const double iter_mean = static_cast<double>(t.iterations_sum) / static_cast<double>(count);
+  const Accuracy& worst = t.worst;
+  const double raw_max = t.raw_max;
+  const int failures = t.failures, fallbacks = t.fallbacks, iterations_max = t.iterations_max;
+  const int steps_mismatched = t.steps_mismatched, steps_strict = t.steps_strict;
 
   if (o.json) {
     config::JsonWriter w;

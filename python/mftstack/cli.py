@@ -364,51 +364,52 @@ def cmd_logs(args):
     return 0
 
 
-def main(argv=None):
+def stack_options(sp):
+    """The options of a command that starts a stack (run, up)."""
+    sp.add_argument("scenario", help="scenario file (config/scenarios/*.yaml)")
+    sp.add_argument("--domain", type=int, default=0, help="DDS domain id, 0..232 (default 0)")
+    sp.add_argument("--mode", default="lockstep", help="lockstep (deterministic, as fast as possible) or realtime")
+    sp.add_argument("--record", metavar="FILE", help="record every topic to this MRPT rawlog (an existing "
+                    "recording is refused)")
+    sp.add_argument("--overwrite", action="store_true", help="with --record: replace an existing recording")
+    sp.add_argument("--bin-dir", default=str(DEFAULT_BIN), help=f"where the service executables are (default {DEFAULT_BIN})")
+    sp.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help=f"configuration folder (default {DEFAULT_CONFIG})")
+    sp.add_argument("--profile", action="append", metavar="NAME",
+                    help="configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, "
+                         "applied in order; docs/profiles.md)")
+    sp.add_argument("--run-dir", help="folder for logs and summaries (default runs/<scenario>-<time>-d<domain>)")
+    sp.add_argument("--no-rt", action="store_true", help="realtime mode: do not ask for SCHED_FIFO")
+    sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
+                    "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
+                    "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
+    sp.add_argument("--rt-chain-order", action="store_true", help="realtime: SCHED_FIFO priorities rising along "
+                    "the chain (sim 76, estimator 77, planner 78, wbc 79) instead of 80 for all; with --chain-cpu N "
+                    "each hand-off is a same-core preemption (docs/loop-benchmark.md)")
+    sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
+                    "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
+    sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
+                    "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
+                    "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "
+                    "lockstep stack on the CPU its domain picks (domain modulo the CPUs allowed), realtime and "
+                    "--stack unpinned; none: no pinning")
+    sp.add_argument("--chain-transport", choices=["shm", "dds"],
+                    help="how the chain's topics go from service to service: shm (a shared-memory segment per "
+                    "stack, a hop about one thread wake-up; DDS still carries every topic to every reader outside "
+                    "the chain, and the chain still hears DDS writers from outside the stack, such as mft-inject) "
+                    "or dds (DDS alone). Default: shm. --secure and --stack always use DDS "
+                    "(docs/loop-benchmark.md)")
+    sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
+                    "identities in DIR (scripts/make-security.sh; docs/security.md)")
+    sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "
+                    "(config/stacks/*.yaml; docs/distributed.md); default: every service here on 127.0.0.1")
+    sp.add_argument("--host", metavar="NAME", help="with --stack: start only the services placed on this host (one "
+                    "supervisor per machine; 'run' on the simulator's host, 'up' on the others)")
+
+
+def build_parser():
     p = argparse.ArgumentParser(prog="mft-supervisor", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-
-    def stack_options(sp):
-        sp.add_argument("scenario", help="scenario file (config/scenarios/*.yaml)")
-        sp.add_argument("--domain", type=int, default=0, help="DDS domain id, 0..232 (default 0)")
-        sp.add_argument("--mode", default="lockstep", help="lockstep (deterministic, as fast as possible) or realtime")
-        sp.add_argument("--record", metavar="FILE", help="record every topic to this MRPT rawlog (an existing "
-                        "recording is refused)")
-        sp.add_argument("--overwrite", action="store_true", help="with --record: replace an existing recording")
-        sp.add_argument("--bin-dir", default=str(DEFAULT_BIN), help=f"where the service executables are (default {DEFAULT_BIN})")
-        sp.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help=f"configuration folder (default {DEFAULT_CONFIG})")
-        sp.add_argument("--profile", action="append", metavar="NAME",
-                        help="configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, "
-                             "applied in order; docs/profiles.md)")
-        sp.add_argument("--run-dir", help="folder for logs and summaries (default runs/<scenario>-<time>-d<domain>)")
-        sp.add_argument("--no-rt", action="store_true", help="realtime mode: do not ask for SCHED_FIFO")
-        sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
-                        "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
-                        "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
-        sp.add_argument("--rt-chain-order", action="store_true", help="realtime: SCHED_FIFO priorities rising along "
-                        "the chain (sim 76, estimator 77, planner 78, wbc 79) instead of 80 for all; with --chain-cpu N "
-                        "each hand-off is a same-core preemption (docs/loop-benchmark.md)")
-        sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
-                        "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
-        sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
-                        "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
-                        "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "
-                        "lockstep stack on the CPU its domain picks (domain modulo the CPUs allowed), realtime and "
-                        "--stack unpinned; none: no pinning")
-        sp.add_argument("--chain-transport", choices=["shm", "dds"],
-                        help="how the chain's topics go from service to service: shm (a shared-memory segment per "
-                        "stack, a hop about one thread wake-up; DDS still carries every topic to every reader outside "
-                        "the chain, and the chain still hears DDS writers from outside the stack, such as mft-inject) "
-                        "or dds (DDS alone). Default: shm. --secure and --stack always use DDS "
-                        "(docs/loop-benchmark.md)")
-        sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
-                        "identities in DIR (scripts/make-security.sh; docs/security.md)")
-        sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "
-                        "(config/stacks/*.yaml; docs/distributed.md); default: every service here on 127.0.0.1")
-        sp.add_argument("--host", metavar="NAME", help="with --stack: start only the services placed on this host (one "
-                        "supervisor per machine; 'run' on the simulator's host, 'up' on the others)")
-
     sp = sub.add_parser("run", help="run a scenario to its end and print a summary")
     stack_options(sp)
     sp.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -438,6 +439,11 @@ def main(argv=None):
     sp.add_argument("--host", metavar="NAME", help="the stack of this host (started with up --host NAME)")
     sp.set_defaults(func=cmd_logs)
 
+    return p
+
+
+def main(argv=None):
+    p = build_parser()
     args = p.parse_args(argv)
     if hasattr(args, "record") and getattr(args, "record", None) is None:
         args.record = None

@@ -280,6 +280,8 @@ def write_yaml_scenario(path, s):
             return "true" if x else "false"
         if isinstance(x, float):
             return repr(round(x, 6))
+        if isinstance(x, int):
+            return str(x)  # a plain number: a quoted one is text, which the strict loader refuses for a number
         if isinstance(x, str) and x.replace("_", "").replace("-", "").replace(".", "").isalnum():
             return x
         return json.dumps(str(x))  # a JSON string is a valid YAML double-quoted scalar

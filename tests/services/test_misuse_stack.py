@@ -83,7 +83,8 @@ class MisuseStackTest(StackTestCase):
         deadline = time.monotonic() + 20
         while time.monotonic() < deadline and "status: complete" not in (sidecar.read_text() if sidecar.exists() else ""):
             time.sleep(0.1)
-        self.assertIn("status: complete", sidecar.read_text()[-300:])  # the recording section is last
+        recording_section = sidecar.read_text().rsplit("\nrecording:\n", 1)[-1]  # the section is last
+        self.assertIn("  status: complete", recording_section)
         self.assertTrue((Path("/dev/shm") / segments[0]).exists())  # nobody left to remove it ...
         r = self.sup("run", SCENARIOS / "stand.yaml", "--domain", domain + 1, "--run-dir", self.tmp / "next")
         self.assertEqual(r.returncode, 0, r.stderr)

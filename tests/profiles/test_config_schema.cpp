@@ -14,6 +14,7 @@
 #include "common/json_writer.hpp"
 #include "common/live_tuning.hpp"
 #include "common/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 #include "planner/planner_config.hpp"
 #include "planner/planner_tuning.hpp"
 #include "sim/terrain.hpp"
@@ -24,12 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string readFile(const fs::path& p) { return test::readTextFile(p.string()); }
 
 std::string plannerText() { return readFile(fs::path(MFT_CONFIG_DIR) / "planner.yaml"); }
 

@@ -10,6 +10,7 @@
 
 #include "common/profiles.hpp"
 #include "common/strict_yaml.hpp"
+#include "tests/support/config_test_support.hpp"
 #include "chain/scenario.hpp"
 #include "tools/closedloop/closed_loop.hpp"
 
@@ -18,12 +19,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string readFile(const fs::path& p) { return test::readTextFile(p.string()); }
 
 // A config folder with copies of the project's files and the given profile files.
 class ProfileDir : public ::testing::Test {

@@ -59,7 +59,7 @@ def stats(values_us):
         return {"count": 0}
     p = lambda q: v[min(len(v) - 1, int(q * len(v)))]
     return {"count": len(v), "mean": round(statistics.fmean(v), 2), "min": round(v[0], 2), "p50": round(p(0.5), 2),
-            "p99": round(p(0.99), 2), "max": round(v[-1], 2)}
+            "p99": round(p(0.99), 2), "p99_9": round(p(0.999), 2), "max": round(v[-1], 2)}
 
 
 def hop_table(run_dir, skip=100, realtime=False):

@@ -382,16 +382,17 @@ def stack_options(sp):
     sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
                     "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
                     "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
-    sp.add_argument("--rt-chain-order", action="store_true", help="realtime: SCHED_FIFO priorities rising along "
-                    "the chain (sim 76, estimator 77, planner 78, wbc 79) instead of 80 for all; with --chain-cpu N "
-                    "each hand-off is a same-core preemption (docs/loop-benchmark.md)")
+    sp.add_argument("--rt-priorities", choices=["chain", "flat"], default="chain", help="realtime: SCHED_FIFO "
+                    "priorities rising along the chain (chain, the default: sim 76, estimator 77, planner 78, wbc "
+                    "79; with the chain on one core each hand-off is a same-core preemption) or 80 for all (flat); "
+                    "docs/loop-benchmark.md")
     sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
                     "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
     sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
                     "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
-                    "(lockstep: faster, and recording costs less; docs/loop-benchmark.md); auto (the default): a "
-                    "lockstep stack on the CPU its domain picks (domain modulo the CPUs allowed), realtime and "
-                    "--stack unpinned; none: no pinning")
+                    "(lockstep: faster, and recording costs less; realtime: a shorter and steadier sensor-to-command "
+                    "latency; docs/loop-benchmark.md); auto (the default): on the CPU the stack's domain picks "
+                    "(domain modulo the CPUs allowed), --stack unpinned; none: no pinning")
     sp.add_argument("--chain-transport", choices=["shm", "dds"],
                     help="how the chain's topics go from service to service: shm (a shared-memory segment per "
                     "stack, a hop about one thread wake-up; DDS still carries every topic to every reader outside "

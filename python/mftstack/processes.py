@@ -41,20 +41,21 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
     """The CPU the control chain is pinned to, or None: --chain-cpu N, "none" (no pinning) or "auto" (the
     default when the option is not given).
 
-    A lockstep tick is a relay (sim -> estimator -> planner -> wbc -> sim) in which one process runs at a time:
-    on one core every hand-off is a local wake-up, while a wake-up on another, idle, vCPU costs tens of us on
-    a VM (docs/loop-benchmark.md). "auto" pins a lockstep stack to one of the CPUs this process may use, chosen
-    by its DDS domain, so that the stacks of mft-experiment's local workers (consecutive domains) each get
-    their own core; realtime stacks and multi-host stacks (--stack) are not pinned by "auto". Measured
-    (docs/loop-benchmark.md, interleaved A/B under load): the pinned chain ran a lockstep tick in ~0.7x the time
-    of the unpinned one."""
+    A tick is a relay (sim -> estimator -> planner -> wbc -> sim) in which one process runs at a time: on one
+    core every hand-off is a local wake-up, while a wake-up on another, idle, vCPU costs tens of us on a VM
+    (docs/loop-benchmark.md). "auto" pins the chain of a single-host stack to one of the CPUs this process may
+    use, chosen by its DDS domain, so that the stacks of mft-experiment's local workers (consecutive domains)
+    each get their own core; multi-host stacks (--stack) are not pinned by "auto". Measured
+    (docs/loop-benchmark.md): in lockstep the pinned chain ran a tick in ~0.7x the time of the unpinned one;
+    in realtime (with the priorities rising along the chain) the sensor-to-command p50 fell ~3x and its p99
+    ~1.7x on a 2-vCPU VM."""
     if chain_cpu is None:
         chain_cpu = "auto"
     if chain_cpu == "none":
         return None
     allowed = sorted(os.sched_getaffinity(0))
     if chain_cpu == "auto":
-        if mode != "lockstep" or multi_host:
+        if multi_host:
             return None
         return allowed[domain % len(allowed)]
     try:
@@ -133,19 +134,19 @@ def chain_shm_name(args, multi_host):
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
 
-# --rt-chain-order: SCHED_FIFO priorities rising along the chain, so that on one core each hand-off (sim ->
-# estimator -> planner -> wbc) preempts the writer at once; the WBC's command then waits for the chain's threads
-# to finish their ticks. Off by default until measured (docs/loop-benchmark.md).
+# --rt-priorities chain (the default): SCHED_FIFO priorities rising along the chain, so that on one core each
+# hand-off (sim -> estimator -> planner -> wbc) preempts the writer at once; "flat" runs them all at 80.
+# Measured on and off in docs/loop-benchmark.md ("The realtime tail, measure by measure").
 RT_CHAIN_PRIORITIES = {"mft-sim": 76, "mft-estimator": 77, "mft-planner": 78, "mft-wbc": 79}
 
 
 def realtime_options(name, args):
-    """The options of service `name` for the realtime knobs: --rt-priority with --rt-chain-order, mft-sim's
+    """The options of service `name` for the realtime knobs: --rt-priority with --rt-priorities chain, mft-sim's
     --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
     if args.mode != "realtime" or getattr(args, "no_rt", False):
         return []
     extra = []
-    if getattr(args, "rt_chain_order", False) and name in RT_CHAIN_PRIORITIES:
+    if getattr(args, "rt_priorities", "chain") == "chain" and name in RT_CHAIN_PRIORITIES:
         extra += ["--rt-priority", str(RT_CHAIN_PRIORITIES[name])]
     if name == "mft-sim" and getattr(args, "sim_spin_us", 0):
         extra += ["--spin-us", str(args.sim_spin_us)]

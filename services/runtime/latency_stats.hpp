@@ -29,11 +29,11 @@ class LatencyStats {
     std::nth_element(s.begin(), s.begin() + static_cast<long>(k), s.end());
     return s[k];
   }
-  // {"mean": .., "p50": .., "p99": .., "max": .., "count": ..}
+  // {"mean": .., "p50": .., "p99": .., "p99_9": .., "max": .., "count": ..}
   std::string json() const {
     config::JsonWriter w;
     w.beginObject().fixedField("mean", mean(), 3).fixedField("p50", percentile(0.5), 3);
-    w.fixedField("p99", percentile(0.99), 3).fixedField("max", max(), 3).field("count", count_);
+    w.fixedField("p99", percentile(0.99), 3).fixedField("p99_9", percentile(0.999), 3).fixedField("max", max(), 3).field("count", count_);
     return w.endObject().str();
   }
 

@@ -16,7 +16,7 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("summary", "write a JSON summary to this file at exit");
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
-  cli.option("rt-priority", "with --rt: the SCHED_FIFO priority (the supervisor's --rt-chain-order gives the chain's "
+  cli.option("rt-priority", "with --rt: the SCHED_FIFO priority (the supervisor's --rt-priorities chain gives the chain's "
              "services rising priorities along the chain)", "80");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "

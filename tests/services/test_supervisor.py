@@ -82,7 +82,8 @@ class ChainPlacementTest(unittest.TestCase):
             self.assertEqual(chain_cpu_for("auto", "lockstep", domain, False), allowed[domain % len(allowed)])
         if len(allowed) > 1:
             self.assertNotEqual(chain_cpu_for("auto", "lockstep", 20, False), chain_cpu_for("auto", "lockstep", 21, False))
-        self.assertIsNone(chain_cpu_for("auto", "realtime", 3, False))
+        self.assertEqual(chain_cpu_for("auto", "realtime", 3, False), allowed[3 % len(allowed)])
+        self.assertIsNone(chain_cpu_for("auto", "realtime", 3, True))
         self.assertIsNone(chain_cpu_for(None, "lockstep", 3, True))
         self.assertIsNone(chain_cpu_for("none", "lockstep", 3, False))
         self.assertEqual(chain_cpu_for(str(allowed[-1]), "realtime", 3, False), allowed[-1])
@@ -98,28 +99,30 @@ class ChainPlacementTest(unittest.TestCase):
 
 
 class RealtimeKnobsTest(unittest.TestCase):
-    """--rt-chain-order and --sim-spin-us reach the services they are for, in realtime with --rt only."""
+    """--rt-priorities and --sim-spin-us reach the services they are for, in realtime with --rt only."""
 
     def args(self, **kw):
-        base = dict(mode="realtime", no_rt=False, rt_chain_order=False, sim_spin_us=0)
+        base = dict(mode="realtime", no_rt=False, rt_priorities="chain", sim_spin_us=0)
         base.update(kw)
         return argparse.Namespace(**base)
 
     def test_priorities_rise_along_the_chain(self):
-        args = self.args(rt_chain_order=True)
+        args = self.args()  # the default
         chain = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
         prios = [int(realtime_options(n, args)[1]) for n in chain]
         self.assertEqual(prios, sorted(prios))
         self.assertEqual(len(set(prios)), 4)
         self.assertTrue(all(1 <= p < 80 for p in prios))  # below the stall probe and the tests' watchers (85)
         self.assertEqual(realtime_options("mft-record", args), [])
+        self.assertEqual(realtime_options("mft-wbc", self.args(rt_priorities="flat")), [])
 
     def test_spin_goes_to_the_simulator_alone_and_nothing_in_lockstep(self):
-        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150)), ["--spin-us", "150"])
-        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150, rt_chain_order=True)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True, rt_chain_order=True)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args()), [])
+        flat = dict(rt_priorities="flat")
+        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150, **flat)), ["--spin-us", "150"])
+        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150, **flat)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(**flat)), [])
 
 
 class ChainTransportTest(unittest.TestCase):

@@ -134,10 +134,13 @@ def chain_shm_name(args, multi_host):
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
 
-# --rt-priorities chain (the default): SCHED_FIFO priorities rising along the chain, so that on one core each
-# hand-off (sim -> estimator -> planner -> wbc) preempts the writer at once; "flat" runs them all at 80.
-# Measured on and off in docs/loop-benchmark.md ("The realtime tail, measure by measure").
-RT_CHAIN_PRIORITIES = {"mft-sim": 76, "mft-estimator": 77, "mft-planner": 78, "mft-wbc": 79}
+# --rt-priorities chain (the default): SCHED_FIFO priorities rising along the chain from the estimator to the
+# simulator, which consumes the chain's end product (the command). With the chain on one core each hand-off
+# (estimator -> planner -> wbc) preempts the writer at once, and the WBC's command preempts the WBC itself: the
+# simulator has it before the writers' post-write work runs. "flat" runs them all at 80. Measured
+# (docs/loop-benchmark.md, "The realtime tail, measure by measure"): with the simulator lowest instead
+# (sim 76 ... wbc 79) the command waited for the estimator's and the planner's remaining work, p50 +50-100 us.
+RT_CHAIN_PRIORITIES = {"mft-estimator": 76, "mft-planner": 77, "mft-wbc": 78, "mft-sim": 79}
 
 
 def realtime_options(name, args):

@@ -108,7 +108,7 @@ class RealtimeKnobsTest(unittest.TestCase):
 
     def test_priorities_rise_along_the_chain(self):
         args = self.args()  # the default
-        chain = ["mft-sim", "mft-estimator", "mft-planner", "mft-wbc"]
+        chain = ["mft-estimator", "mft-planner", "mft-wbc", "mft-sim"]  # the simulator consumes the command
         prios = [int(realtime_options(n, args)[1]) for n in chain]
         self.assertEqual(prios, sorted(prios))
         self.assertEqual(len(set(prios)), 4)

@@ -212,7 +212,7 @@ class DistributedTest(StackTestCase):
         # damping mode's gain (3 N m s/rad) brakes the weight little: the simulator alone sinks a standing
         # robot 11 cm in 200 ms with it and 17 cm with none (test_sim SimDampingSag). The final height is the
         # commanded robot's: `down` stops the simulator and waits for it before it ends the controller (before,
-        # the WBC could end first and the last ticks under damping sagged the robot 1.6 cm on a loaded machine).
+        # the WBC could end first, leaving the simulator's last ticks to the damping mode on a loaded machine).
         self.assertLess(abs(sim["final_base_height_m"] - STAND_HEIGHT_M), 0.01, sim["final_base_height_m"])
 
     def test_4_discovery_server_lockstep(self):

@@ -1,0 +1,48 @@
+#!/usr/bin/env python3
+"""Markdown rows of the realtime figures of measure-stack.py JSON files, one row per file (docs/results pages quote
+these rows; test docs_results_pages regenerates them from the files the page cites)."""
+import argparse
+import json
+import sys
+from pathlib import Path
+
+HEADER = ["| run | sensor → command p50 / p99 / p99.9 / max [µs] | timer lateness p99 on the chain's CPU "
+          "(other CPU) [µs] | p99 over the timer's | WBC tick p99 realtime / lockstep [µs] | simulator misses "
+          "(not in a CPU stall) | load before → after |",
+          "|---|---|---|---|---|---|---|"]
+
+
+def row(path):
+    d = json.loads(Path(path).read_text())
+    rt = d["realtime"]
+    s, w = rt["sensor_to_command_latency_us"], rt["wbc_tick_us"]
+    lock = next(iter(d["lockstep"].values()))
+    wbc_lock = next(i for i in lock["hop_table"]["intervals"] if i["interval"] == "WBC compute")
+    late = d["machine_wakeup"]["timer_late_us"]
+    cpu = rt.get("chain_cpu")
+    mine = late[f"cpu{cpu}"]["p99"] if cpu is not None else max(v["p99"] for v in late.values())
+    others = ", ".join(f"{v['p99']:.0f}" for k, v in sorted(late.items()) if cpu is None or k != f"cpu{cpu}")
+    return (f"| {Path(path).stem} | {s['p50']:.0f} / {s['p99']:.0f} / {s.get('p99_9', float('nan')):.0f} / "
+            f"{s['max']:.0f} | {mine:.0f} ({others}) | {s['p99'] - mine:+.0f} | {w['p99']:.0f} / {wbc_lock['p99']:.0f} "
+            f"| {rt['sim_deadline_misses']} ({rt['sim_misses_unexplained']}) | "
+            f"{d['load_average_before']['1min']:.2f} → {d['load_average_after']['1min']:.2f} |")
+
+
+def table(paths):
+    return HEADER + [row(p) for p in paths]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("files", nargs="+", help="JSON files written by scripts/measure-stack.py --json")
+    a = ap.parse_args()
+    try:
+        print("\n".join(table(a.files)))
+    except (OSError, ValueError, KeyError, StopIteration) as e:
+        print(f"realtime-table: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

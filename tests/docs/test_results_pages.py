@@ -1,0 +1,74 @@
+"""Numbers on the results pages equal the results files they cite.
+
+A results page marks a generated block with
+    <!-- generated: KIND FILE [FILE ...] -->  ...  <!-- end generated -->
+(FILE relative to docs/). KIND recovery-map: the block's table rows and outcome lines are what
+`mft-experiment recovery-map` writes to table.md for that map.json (its own renderer, run again here);
+KIND realtime: the rows `scripts/realtime-table.py` makes of those measure-stack.py JSON files.
+Also: the README's Table II is the stack Table II the recovery map prints beside its lift-off column.
+"""
+import argparse
+import importlib.util
+import pathlib
+import re
+import sys
+import unittest
+
+ARGS = None
+BLOCK = re.compile(r"<!-- generated: ([\w-]+) ([^>]+?) -->\n(.*?)<!-- end generated -->", re.S)
+
+
+def load_module(path, name):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+class ResultsPages(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.root = pathlib.Path(ARGS.source_dir).resolve()
+        for lib in ("python", "tools/mft-experiment"):
+            if (cls.root / lib / "mftexp").is_dir():
+                sys.path.insert(0, str(cls.root / lib))
+        from mftexp import recovery_report
+        cls.recovery_report = recovery_report
+        cls.realtime_table = load_module(cls.root / "scripts" / "realtime-table.py", "realtime_table")
+        cls.blocks = [(page, kind, files.split(), body) for page in sorted((cls.root / "docs").rglob("*.md"))
+                      for kind, files, body in BLOCK.findall(page.read_text())]
+
+    def rendered(self, kind, files):
+        paths = [self.root / "docs" / f for f in files]
+        if kind == "recovery-map":
+            self.assertEqual(len(paths), 1)
+            lines = self.recovery_report.table_lines(self.recovery_report.load_report(paths[0]))
+        elif kind == "realtime":
+            lines = self.realtime_table.table([str(p) for p in paths])
+        else:
+            self.fail(f"unknown generated block kind {kind}")
+        return [ln for ln in lines if ln.startswith(("|", "- "))]
+
+    def test_every_generated_block_is_what_its_files_give(self):
+        kinds = {kind for _, kind, _, _ in self.blocks}
+        self.assertTrue({"recovery-map", "realtime"} <= kinds, kinds)
+        for page, kind, files, body in self.blocks:
+            with self.subTest(page=page.name, files=files):
+                quoted = [ln for ln in body.splitlines() if ln.startswith(("|", "- "))]
+                self.assertEqual(quoted, self.rendered(kind, files))
+
+    def test_readme_table_ii_is_the_stack_table_the_maps_print(self):
+        text = (self.root / "README.md").read_text()
+        heights = [float(h) for h in re.search(r"\| z_B\^ref \[m\] \|(.*)\|", text).group(1).split("|")]
+        cells = re.search(r"\| I_max SA-WBC / MFT-WBC \[N s\] \|(.*)\|", text).group(1).split("|")
+        for h, cell in zip(heights, cells):
+            sa, mft = (float(v) for v in cell.split("/"))
+            self.assertEqual(self.recovery_report.STACK_TABLE2["sa"][h], sa)
+            self.assertEqual(self.recovery_report.STACK_TABLE2["mft"][h], mft)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--source-dir", required=True)
+    ARGS, rest = parser.parse_known_args()
+    unittest.main(argv=[sys.argv[0]] + rest)

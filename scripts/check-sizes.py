@@ -17,14 +17,6 @@ FLOORS = ("tools", "services", "python", "chain")
 FUNCTION_LIMIT = 80
 MAIN_LIMIT = 150
 CXX_SUFFIXES = (".cpp", ".hpp", ".h", ".cc")
-# Over the limits and not yet split, each at its length when it was listed: --check reports them as known and
-# fails only when one grows or a new one appears; a listed one split below the limit must leave this list (a
-# stale entry fails too). The four service mains are the ones left.
-KNOWN_OVER = {
-    ("services/record/main.cpp", "toolMain"): 135, ("services/sim/main.cpp", "toolMain"): 126,
-    ("services/wbc/main.cpp", "toolMain"): 115, ("services/planner/main.cpp", "toolMain"): 96,
-    ("services/record/main.cpp", "<main file>"): 159, ("services/sim/main.cpp", "<main file>"): 153,
-}
 
 
 def strip_cxx(text):
@@ -212,17 +204,10 @@ def report(files):
     long_functions = [dict(fn, file=f["path"]) for f in files for fn in f["functions"]
                       if fn["length"] > FUNCTION_LIMIT]
     long_mains = {p: n for p, n in mains.items() if n > MAIN_LIMIT}
-    over = {(fn["file"], fn["name"]): fn["length"] for fn in long_functions}
-    over.update({(p, "<main file>"): n for p, n in long_mains.items()})
-    known = {k: n for k, n in over.items() if k in KNOWN_OVER and n <= KNOWN_OVER[k]}
-    stale = sorted(f"{path} {name}" for (path, name) in KNOWN_OVER if (path, name) not in over)
-    long_functions = [fn for fn in long_functions if (fn["file"], fn["name"]) not in known]
-    long_mains = {p: n for p, n in long_mains.items() if (p, "<main file>") not in known}
     tools_total = sum(f["lines"] for f in files if f["path"].startswith("tools/"))
     return {"function_limit": FUNCTION_LIMIT, "main_limit": MAIN_LIMIT, "tools_code_lines": tools_total,
             "longest_per_folder": longest, "mains": mains,
-            "violations": {"functions": long_functions, "mains": long_mains, "stale_known": stale},
-            "known_over": [{"file": p, "name": n, "length": k} for (p, n), k in sorted(known.items())]}
+            "violations": {"functions": long_functions, "mains": long_mains}}
 
 
 def print_text(r):
@@ -233,11 +218,7 @@ def print_text(r):
     print(f"mains (limit {r['main_limit']}):")
     for path, n in sorted(r["mains"].items()):
         print(f"  {n:5d}  {path}")
-    for k in r["known_over"]:
-        print(f"  known, not yet split: {k['length']:4d}  {k['file']} {k['name']}")
     v = r["violations"]
-    for entry in v["stale_known"]:
-        print(f"  stale KNOWN_OVER entry (now within the limit: remove it): {entry}")
     if v["functions"] or v["mains"]:
         print(f"violations: {len(v['functions'])} functions over {r['function_limit']} lines, "
               f"{len(v['mains'])} mains over {r['main_limit']} lines")
@@ -265,7 +246,7 @@ def main():
     else:
         print_text(r)
     v = r["violations"]
-    return 1 if args.check and (v["functions"] or v["mains"] or v["stale_known"]) else 0
+    return 1 if args.check and (v["functions"] or v["mains"]) else 0
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@
 
 #include "idl/msg_pubsub.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "services/runtime/topic_qos.hpp"
 
 namespace mft::services {
 
@@ -36,7 +37,7 @@ class VerdictPublisher {
       : service_(service), source_(source) {
     try {
       writer_ = std::make_unique<TopicWriter<msg::CommandVerdict, msg::CommandVerdictPubSubType>>(
-          participant, "CommandVerdict", "verdict_writer");
+          participant, "CommandVerdict", serviceWriterProfile("CommandVerdict", false));  // an event: either mode
     } catch (const DdsError& e) {
       std::fprintf(stderr, "%s: warning: %s: operator commands get no verdict\n", service_, e.what());
     }

@@ -27,8 +27,8 @@ class DdsError : public std::runtime_error {
 // Highest domain id usable with the default UDP port mapping of Fast DDS (PB 7400 + DG 250 * domain < 65536).
 constexpr int kMaxDomainId = 232;
 
-// The QoS profiles of the chain (ServiceContext::chainWriterProfile/chainReaderProfile); the chain channel carries
-// only the topics written and read with these.
+// The QoS profiles of the chain (a chain topic's in topic_qos.hpp); the chain channel carries only the topics
+// written and read with these.
 inline constexpr const char* kLockstepWriterProfile = "lockstep_writer";
 inline constexpr const char* kLockstepReaderProfile = "lockstep_reader";
 inline constexpr const char* kRealtimeWriterProfile = "control_writer";

@@ -27,6 +27,7 @@
 #include "idl/msg_pubsub.hpp"
 #include "services/runtime/command_verdict.hpp"
 #include "services/runtime/topic_io.hpp"
+#include "services/runtime/topic_qos.hpp"
 
 namespace mft::services {
 
@@ -37,6 +38,14 @@ bool writeTuningStatus(const std::string& path, const std::string& json);
 // The text of configuration file `path` as the loaders read it (the active profiles applied). Throws
 // config::ConfigError when it cannot be read.
 std::string configTextInForce(const std::string& path);
+
+// What a service with live changes loads before its endpoints exist: its node, and the text of its configuration
+// file as loaded (the active profiles applied), the base of live changes.
+template <class Node>
+struct TunableNode {
+  std::unique_ptr<Node> node;
+  std::string config_text;
+};
 
 template <class Tuning>
 class LiveTuning {
@@ -63,14 +72,15 @@ class LiveTuning {
     // A secured stack whose permissions predate ConfigChange runs on without live tuning, with a warning.
     try {
       applied_writer_ = std::make_unique<TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>>(
-          participant, "ConfigChange", "verdict_writer");
+          participant, "ConfigChange", serviceWriterProfile("ConfigChange", lockstep));
     } catch (const DdsError& e) {
       std::fprintf(stderr, "%s: warning: %s: applied live changes are not published (nor recorded)\n", service_, e.what());
     }
     worker_ = std::thread([this] { run(); });
     try {
       reader_ = std::make_unique<TopicReader<msg::ConfigChange, msg::ConfigChangePubSubType>>(
-          participant, "ConfigChange", "event_reader", [this](const msg::ConfigChange& m) { onRequest(m); });
+          participant, "ConfigChange", serviceReaderProfile("ConfigChange", lockstep),
+          [this](const msg::ConfigChange& m) { onRequest(m); });
     } catch (const DdsError& e) {
       std::fprintf(stderr, "%s: warning: %s: no live tuning\n", service_, e.what());
     }

@@ -4,11 +4,13 @@
 #include <sys/mman.h>
 
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <thread>
 
 namespace mft::services {
 
@@ -26,6 +28,9 @@ void installShutdownHandlers() {
 }
 bool shutdownRequested() { return g_shutdown != 0; }
 void requestShutdown() { g_shutdown = 1; }
+void waitForShutdown() {
+  while (!shutdownRequested()) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
 
 namespace {
 // Touches the stack a service's loop may reach, so that with the memory locked its first deep call takes no page

@@ -13,6 +13,9 @@ namespace mft::services {
 void installShutdownHandlers();
 bool shutdownRequested();
 void requestShutdown();
+// Returns once shutdown is requested (looked at every 10 ms): the main thread of a service whose work runs in
+// its DDS callbacks.
+void waitForShutdown();
 
 // Tries SCHED_FIFO at `priority` and mlockall; on failure prints a warning to stderr and carries on.
 // Returns true when both took effect. Call before creating the DDS participant so its threads inherit it.

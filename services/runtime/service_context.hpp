@@ -1,7 +1,7 @@
 #pragma once
 // What every service main starts with: the common options of the service contract (see
-// services/mft-supervisor), the robot description, the scenario, the DDS participant, the QoS profile names
-// of the chosen loop mode, and the JSON summary written at exit.
+// services/mft-supervisor), the robot description, the scenario, the DDS participant, the endpoints' QoS profiles
+// (from the topic registry and the loop mode), and the JSON summary written at exit.
 #include <memory>
 #include <string>
 #include <vector>
@@ -9,6 +9,8 @@
 #include "model/robot_description.hpp"
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/process.hpp"
+#include "services/runtime/topic_io.hpp"
+#include "services/runtime/topic_qos.hpp"
 #include "chain/scenario.hpp"
 
 namespace mft::services {
@@ -42,10 +44,11 @@ class ServiceContext {
   std::string configFile(const std::string& name) const { return config_dir_ + "/" + name; }
   DdsParticipant& participant() { return *participant_; }
 
-  // QoS profiles of the 1 kHz chain: reliable in lockstep (every tick must arrive), deadline-watched
-  // best effort in realtime.
-  std::string chainWriterProfile() const { return lockstep() ? kLockstepWriterProfile : kRealtimeWriterProfile; }
-  std::string chainReaderProfile() const { return lockstep() ? kLockstepReaderProfile : kRealtimeReaderProfile; }
+  // This service's writer or reader on `topic`, with the QoS profile of the topic's row in the registry and the
+  // loop mode (topic_qos.hpp): the 1 kHz chain's is reliable in lockstep (every tick must arrive),
+  // deadline-watched best effort in realtime.
+  TopicEndpoint writing(const std::string& topic) { return {participant(), topic, serviceWriterProfile(topic, lockstep())}; }
+  TopicEndpoint reading(const std::string& topic) { return {participant(), topic, serviceReaderProfile(topic, lockstep())}; }
 
   // Writes `json` (an object) to the --summary file, if one was given. Never throws.
   void writeSummary(const std::string& json) const;

@@ -39,6 +39,14 @@ class TickJoin {
     }
     return true;
   }
+  // accept() and admit() of the tick-naming input in one: false when it is refused or a stray tick; `new_clock`
+  // (if given) is set when the simulator restarted.
+  bool acceptTick(bool valid, const char* topic, std::uint64_t tick, bool* new_clock = nullptr) {
+    bool restarted = false;
+    if (!accept(valid, topic, tick) || !admit(tick, &restarted)) return false;
+    if (new_clock) *new_clock = restarted;
+    return true;
+  }
   // What to do for `tick` with the inputs now held: `paired` says whether every input it needs is there;
   // `repeat_answer`: a repeated tick gets the cached answer again (only when its tick-naming input came again,
   // so that a second input topic of the same tick does not double the chain's traffic).

@@ -74,9 +74,18 @@ bool fromChainBytes(PubSubType& type, eprosima::fastrtps::rtps::SerializedPayloa
   return type.deserialize(&payload, msg);
 }
 
+// Where an endpoint goes: the participant, the topic (its name in the registry, idl/topics.yaml) and the QoS
+// profile (a service's: ServiceContext::writing / reading).
+struct TopicEndpoint {
+  DdsParticipant& participant;
+  std::string topic;
+  std::string profile;
+};
+
 template <class Msg, class PubSubType>
 class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
  public:
+  explicit TopicWriter(const TopicEndpoint& e) : TopicWriter(e.participant, e.topic, e.profile) {}
   TopicWriter(DdsParticipant& p, const std::string& topic_name, const std::string& profile) {
     auto* topic = p.topic(topic_name, new PubSubType());
     publisher_ = p.publisher();
@@ -175,6 +184,9 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   using Callback = std::function<void(const Msg&)>;
   // `delivery` matters only on the chain channel: Polled means this reader's thread is never woken for the topic;
   // the owner calls pollChannel() / awaitChannel(). Samples from writers outside the stack come on the DDS thread.
+  TopicReader(const TopicEndpoint& e, Callback on_sample,
+              ChainSlotReader::Delivery delivery = ChainSlotReader::Delivery::Woken)
+      : TopicReader(e.participant, e.topic, e.profile, std::move(on_sample), delivery) {}
   TopicReader(DdsParticipant& p, const std::string& topic_name, const std::string& profile, Callback on_sample,
               ChainSlotReader::Delivery delivery = ChainSlotReader::Delivery::Woken)
       : on_sample_(std::move(on_sample)) {

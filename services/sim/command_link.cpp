@@ -15,7 +15,7 @@ CommandLink::CommandLink(ServiceContext& ctx, HopTrace& hops, double peak_torque
     : lockstep_(ctx.lockstep()),
       hops_(hops),
       driver_(peak_torque_Nm, watchdog_timeout_ns),
-      reader_(ctx.participant(), "JointCommand", ctx.chainReaderProfile(),
+      reader_(ctx.reading("JointCommand"),
               [this](const msg::JointCommand& m) { onCommand(m); },
               ctx.lockstep() ? ChainSlotReader::Delivery::Polled : ChainSlotReader::Delivery::Woken) {}
 

@@ -6,7 +6,7 @@ namespace mft::services {
 
 GaitLink::GaitLink(ServiceContext& ctx)
     : lockstep_(ctx.lockstep()),
-      reader_(ctx.participant(), "Reference", ctx.chainReaderProfile(),
+      reader_(ctx.reading("Reference"),
               [this](const msg::Reference& m) { onReference(m); }, ChainSlotReader::Delivery::Polled) {}
 
 void GaitLink::onReference(const msg::Reference& m) {

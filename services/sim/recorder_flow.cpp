@@ -14,7 +14,7 @@ RecorderFlow::RecorderFlow(ServiceContext& ctx, std::uint64_t window, std::mutex
     : window_(window), mutex_(mutex), changed_(changed) {
   if (window == 0 || !ctx.lockstep()) return;
   reader_ = std::make_unique<TopicReader<msg::RecorderProgress, msg::RecorderProgressPubSubType>>(
-      ctx.participant(), "RecorderProgress", "lockstep_reader", [this](const msg::RecorderProgress& m) {
+      ctx.reading("RecorderProgress"), [this](const msg::RecorderProgress& m) {
         std::lock_guard<std::mutex> lock(mutex_);
         heard_ = true;
         tick_ = std::max(tick_, m.tick());

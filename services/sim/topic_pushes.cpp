@@ -11,7 +11,7 @@ TopicPushes::TopicPushes(ServiceContext& ctx, CommandLink& link, double max_push
       max_push_Ns_(max_push_Ns),
       control_period_s_(control_period_s),
       verdicts_(ctx.participant(), "mft-sim", msg::COMMAND_SOURCE_SIMULATOR),
-      reader_(ctx.participant(), "Disturbance", "event_reader", [this](const msg::Disturbance& m) { onRequest(m); }) {
+      reader_(ctx.reading("Disturbance"), [this](const msg::Disturbance& m) { onRequest(m); }) {
   pending_.reserve(64);
   applied_.reserve(64);
 }

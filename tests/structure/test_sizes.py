@@ -49,23 +49,21 @@ class Sizes(unittest.TestCase):
         v = r["violations"]
         lines = [f"function {f['length']} lines: {f['file']}:{f['line']} {f['name']}" for f in v["functions"]]
         lines += [f"main {n} lines: {p}" for p, n in v["mains"].items()]
-        lines += [f"stale known entry: {s}" for s in v["stale_known"]]
         self.assertEqual(lines, [], "over the limits:\n  " + "\n  ".join(lines))
 
-    def test_a_known_entry_may_not_grow(self):
-        """The list of known oversize functions is a ratchet: one line more than listed is a violation."""
-        r = check_sizes.report(check_sizes.scan(ROOT))
-        self.assertTrue(r["known_over"], "no known entry left: remove KNOWN_OVER and this test")
-        entry = r["known_over"][0]
-        key = (entry["file"], entry["name"])
-        saved = check_sizes.KNOWN_OVER[key]
-        try:
-            check_sizes.KNOWN_OVER[key] = entry["length"] - 1
-            grown = check_sizes.report(check_sizes.scan(ROOT))["violations"]
-            named = [f["file"] for f in grown["functions"]] + list(grown["mains"])
-            self.assertIn(entry["file"], named)
-        finally:
-            check_sizes.KNOWN_OVER[key] = saved
+    def test_a_long_function_and_a_long_main_are_named(self):
+        """The check can fail: a scratch tree with an 81-line function in a 151-line main is two violations."""
+        with tempfile.TemporaryDirectory() as tmp:
+            root = Path(tmp)
+            for floor in check_sizes.FLOORS:
+                (root / floor).mkdir()
+            body = "".join(f"  x += {i};\n" for i in range(79))
+            text = "int main() {\n  int x = 0;\n" + body + "}\n" + "// padding\n" * 69
+            (root / "tools" / "main.cpp").write_text(text)
+            v = check_sizes.report(check_sizes.scan(root))["violations"]
+            self.assertEqual([(f["file"], f["name"], f["length"]) for f in v["functions"]],
+                             [("tools/main.cpp", "main", 82)])
+            self.assertEqual(v["mains"], {"tools/main.cpp": 151})
 
 
 if __name__ == "__main__":

@@ -13,12 +13,7 @@ using namespace mft::planner;
 namespace {
 std::string projectText() { return mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/planner.yaml"); }
 std::string refusal(const std::string& key, const std::string& value) {
-  try {
-    applyPlannerOverride(projectText(), "planner.yaml (live change)", key, value);
-  } catch (const config::ConfigError& e) {
-    return e.what();
-  }
-  return "accepted";
+  return mft::test::refusalOf([&] { applyPlannerOverride(projectText(), "planner.yaml (live change)", key, value); });
 }
 }  // namespace
 

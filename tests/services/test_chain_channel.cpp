@@ -18,21 +18,15 @@
 #include <vector>
 
 #include "services/runtime/chain_channel.hpp"
+#include "tests/support/child_process.hpp"
 
 using namespace mft::services;
+using mft::test::ShmUnlink;
+using mft::test::uniqueShmName;
 using namespace std::chrono_literals;
 
 namespace {
 
-std::string uniqueName(const char* what) {
-  static int counter = 0;
-  return "/mft-test-" + std::string(what) + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
-}
-
-struct Unlink {
-  std::string name;
-  ~Unlink() { shm_unlink(name.c_str()); }
-};
 
 // A sample of `size` bytes whose every byte derives from `n`: a torn or stale copy shows.
 std::vector<unsigned char> pattern(std::uint32_t n, std::size_t size) {
@@ -86,7 +80,7 @@ TEST(ChainChannel, RefusesANameShmOpenWouldNotTake) {
 // it (the writer sends the next sample once the previous one was answered): every sample arrives once, whole,
 // in order; the attach counts are what the simulator waits for.
 TEST(ChainChannel, PingPongDeliversEverySampleOnceAndInOrder) {
-  const Unlink segment{uniqueName("pingpong")};
+  const ShmUnlink segment{uniqueShmName("pingpong")};
   ChainChannel a(segment.name), b(segment.name);
   ChainSlotWriter ping_writer(a, 0);
   ChainSlotWriter pong_writer(b, 4);
@@ -118,7 +112,7 @@ TEST(ChainChannel, PingPongDeliversEverySampleOnceAndInOrder) {
 
 // The same ping-pong with the answering side in a child process (fork): the futex is shared between processes.
 TEST(ChainChannel, PingPongAcrossProcesses) {
-  const Unlink segment{uniqueName("fork")};
+  const ShmUnlink segment{uniqueShmName("fork")};
   ChainChannel parent(segment.name);
   ChainSlotWriter ping_writer(parent, 2);
   Inbox answers;
@@ -158,7 +152,7 @@ TEST(ChainChannel, PingPongAcrossProcesses) {
 // What a slot held before a reader attached belongs to an earlier stack (or tick): it is not delivered; the next
 // write is.
 TEST(ChainChannel, AReaderAttachedLaterGetsOnlyNewSamples) {
-  const Unlink segment{uniqueName("late")};
+  const ShmUnlink segment{uniqueShmName("late")};
   ChainChannel channel(segment.name);
   ChainSlotWriter writer(channel, 1);
   const auto old_sample = pattern(1, 64), new_sample = pattern(2, 64);
@@ -174,7 +168,7 @@ TEST(ChainChannel, AReaderAttachedLaterGetsOnlyNewSamples) {
 // A writer that never waits (latest-value semantics): the reader may skip samples but never delivers a copy
 // that mixes two of them, and what it delivers goes forward.
 TEST(ChainChannel, NeverDeliversATornCopy) {
-  const Unlink segment{uniqueName("torn")};
+  const ShmUnlink segment{uniqueShmName("torn")};
   ChainChannel channel(segment.name);
   ChainSlotWriter writer(channel, 0);
   std::atomic<std::uint64_t> delivered{0}, mixed{0}, backwards{0};
@@ -198,7 +192,7 @@ TEST(ChainChannel, NeverDeliversATornCopy) {
 }
 
 TEST(ChainChannel, RefusesASampleLargerThanItsSlot) {
-  const Unlink segment{uniqueName("large")};
+  const ShmUnlink segment{uniqueShmName("large")};
   ChainChannel channel(segment.name);
   ChainSlotWriter writer(channel, 0);
   const std::vector<unsigned char> too_large(ChainChannel::kSlotBytes + 1, 0);
@@ -208,7 +202,7 @@ TEST(ChainChannel, RefusesASampleLargerThanItsSlot) {
 // The recorder's archive: every sample in order while it drains at least once per ring; a writer that laps it
 // loses the oldest samples, counted, and the archive goes on with the ones still there.
 TEST(ChainChannel, ArchiveTakesEverySampleInOrderAndCountsWhatTheRingLost) {
-  const Unlink segment{uniqueName("archive")};
+  const ShmUnlink segment{uniqueShmName("archive")};
   ChainChannel writer_side(segment.name), recorder_side(segment.name);
   ChainSlotWriter writer(writer_side, 5);
   ChainSlotArchive archive(recorder_side, 5);
@@ -245,7 +239,7 @@ TEST(ChainChannel, ArchiveTakesEverySampleInOrderAndCountsWhatTheRingLost) {
 // not after it was taken off; a restarted service's id takes the oldest place when the list is full, and taking
 // the old id off then leaves the new one alone; the all-zero id is never an endpoint; every change bumps the version.
 TEST(ChainChannel, EndpointListsFindWhatWasAddedAndRecycleTheOldestPlace) {
-  const Unlink segment{uniqueName("endpoints")};
+  const ShmUnlink segment{uniqueShmName("endpoints")};
   ChainChannel channel(segment.name);
   ChainChannel::EndpointList& list = channel.slot(4).stack_writers;
   auto id = [](unsigned char n) {

@@ -15,20 +15,15 @@
 #include <vector>
 
 #include "services/runtime/chain_channel.hpp"
+#include "tests/support/child_process.hpp"
 
 using namespace mft::services;
+using mft::test::ForkedChild;
+using mft::test::ShmUnlink;
+using mft::test::uniqueShmName;
 
 namespace {
 
-std::string uniqueName(const char* what) {
-  static int counter = 0;
-  return "/mft-test-seg-" + std::string(what) + "-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
-}
-
-struct Unlink {
-  std::string name;
-  ~Unlink() { shm_unlink(name.c_str()); }
-};
 
 void writeSegment(const std::string& name, const std::vector<unsigned char>& bytes) {
   const int fd = shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL, 0600);
@@ -47,7 +42,7 @@ std::string openError(const std::string& name) {
 }
 
 TEST(ChainSegment, RandomBytesOfTheRightSizeAreRefused) {
-  const Unlink u{uniqueName("random")};
+  const ShmUnlink u{uniqueShmName("seg-random")};
   std::vector<unsigned char> bytes(ChainChannel::segmentBytes());
   std::mt19937 rng(7);
   for (auto& b : bytes) b = static_cast<unsigned char>(rng());
@@ -58,7 +53,7 @@ TEST(ChainSegment, RandomBytesOfTheRightSizeAreRefused) {
 }
 
 TEST(ChainSegment, AnotherSizeIsRefused) {
-  const Unlink u{uniqueName("size")};
+  const ShmUnlink u{uniqueShmName("seg-size")};
   writeSegment(u.name, std::vector<unsigned char>(4096, 0x5a));
   const std::string error = openError(u.name);
   EXPECT_NE(error.find("has 4096 bytes, not " + std::to_string(ChainChannel::segmentBytes())), std::string::npos)
@@ -67,7 +62,7 @@ TEST(ChainSegment, AnotherSizeIsRefused) {
 
 // A segment made by a process whose parent (the stack's supervisor) and itself are both gone: a stale copy.
 TEST(ChainSegment, SegmentOfAStackThatIsGoneIsRefused) {
-  const Unlink u{uniqueName("stale")};
+  const ShmUnlink u{uniqueShmName("seg-stale")};
   const pid_t child = fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
@@ -89,7 +84,7 @@ TEST(ChainSegment, SegmentOfAStackThatIsGoneIsRefused) {
 }
 
 TEST(ChainSegment, AStackSegmentIsSharedAndSized) {
-  const Unlink u{uniqueName("shared")};
+  const ShmUnlink u{uniqueShmName("seg-shared")};
   ChainChannel first(u.name);
   ChainChannel second(u.name);
   first.slot(2).head.store(41);
@@ -102,12 +97,7 @@ TEST(ChainSegment, AStackSegmentIsSharedAndSized) {
 // the reason, in the constructor, and leave nothing behind.
 TEST(ChainSegment, FullDevShmIsAnErrorNotASigbus) {
   if (geteuid() != 0) GTEST_SKIP() << "needs root for a private mount namespace";
-  int fds[2];
-  ASSERT_EQ(pipe(fds), 0);
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    close(fds[0]);
+  ForkedChild child([] {
     std::string out = "setup";
     if (unshare(CLONE_NEWNS) == 0 && mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) == 0 &&
         mount("tmpfs", "/dev/shm", "tmpfs", 0, "size=64k") == 0) {
@@ -115,16 +105,11 @@ TEST(ChainSegment, FullDevShmIsAnErrorNotASigbus) {
       const int fd = shm_open("/mft-test-seg-full", O_RDONLY, 0);
       if (fd >= 0) out += " [left behind]";
     }
-    if (write(fds[1], out.data(), out.size()) < 0) _exit(2);
-    _exit(0);
-  }
-  close(fds[1]);
-  std::string out;
-  char buf[512];
-  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) > 0;) out.append(buf, static_cast<std::size_t>(n));
-  close(fds[0]);
+    return out;
+  });
+  ASSERT_TRUE(child.started());
   int status = 0;
-  waitpid(child, &status, 0);
+  const std::string out = child.output(&status);
   ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
   if (out == "setup") GTEST_SKIP() << "no private tmpfs here";
   EXPECT_NE(out.find("cannot reserve 3."), std::string::npos) << out;

@@ -6,9 +6,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
+#include <string>
 #include <thread>
 
 #include "services/runtime/stall_probe.hpp"
+#include "tests/support/child_process.hpp"
 
 using mft::services::StallProbe;
 
@@ -66,12 +69,7 @@ TEST(StallProbe, OneThreadPerCpuOfTheProcess) {
 // A child runs a probe (1 ms period, 5 ms threshold) and is stopped for 40 ms: every CPU's thread wakes at
 // least ~35 ms late. It reports its stalls through a pipe.
 TEST(StallProbe, RecordsTheProcessBeingStopped) {
-  int fds[2];
-  ASSERT_EQ(pipe(fds), 0);
-  const pid_t child = fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    close(fds[0]);
+  mft::test::ForkedChild child([] {
     double result[2] = {0, 0};
     {
       StallProbe::Options o;
@@ -82,20 +80,18 @@ TEST(StallProbe, RecordsTheProcessBeingStopped) {
       result[0] = static_cast<double>(probe.stalls());
       result[1] = probe.maxStallMs();
     }
-    if (write(fds[1], result, sizeof result) != sizeof result) _exit(2);
-    _exit(0);
-  }
-  close(fds[1]);
+    return std::string(reinterpret_cast<const char*>(result), sizeof result);
+  });
+  ASSERT_TRUE(child.started());
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
-  kill(child, SIGSTOP);
+  kill(child.pid(), SIGSTOP);
   std::this_thread::sleep_for(std::chrono::milliseconds(40));
-  kill(child, SIGCONT);
-  double result[2] = {0, 0};
-  const ssize_t got = read(fds[0], result, sizeof result);
+  kill(child.pid(), SIGCONT);
   int status = 0;
-  waitpid(child, &status, 0);
-  close(fds[0]);
-  ASSERT_EQ(got, static_cast<ssize_t>(sizeof result));
+  const std::string out = child.output(&status);
+  double result[2] = {0, 0};
+  ASSERT_EQ(out.size(), sizeof result);
+  std::memcpy(result, out.data(), sizeof result);
   EXPECT_GE(result[0], 1.0);
   EXPECT_GE(result[1], 30.0);
 }

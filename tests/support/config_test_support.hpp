@@ -41,4 +41,15 @@ void expectConfigError(const std::string& text, const std::string& pattern, cons
   }
 }
 
+// The message of the ConfigError `apply()` throws, or "accepted" (a live change judged by a strict loader).
+template <class Apply>
+std::string refusalOf(Apply&& apply) {
+  try {
+    apply();
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 }  // namespace mft::test

@@ -19,12 +19,8 @@ namespace {
 std::string projectText() { return mft::test::readTextFile(std::string(MFT_CONFIG_DIR) + "/wbc.yaml"); }
 
 std::string refusal(const std::string& key, const std::string& value) {
-  try {
-    applyWbcOverride(projectText(), "wbc.yaml (live change)", key, value, wbc::test::robot());
-  } catch (const config::ConfigError& e) {
-    return e.what();
-  }
-  return "accepted";
+  return mft::test::refusalOf(
+      [&] { applyWbcOverride(projectText(), "wbc.yaml (live change)", key, value, wbc::test::robot()); });
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "idl/msg_pubsub.hpp"
+#include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "services/runtime/topic_qos.hpp"
 
@@ -45,12 +46,7 @@ class VerdictPublisher {
   }
   // Publishes what is still queued and waits (at most 1 s) until mft-cmd has acknowledged it.
   ~VerdictPublisher() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
+    stopWorker(mutex_, stop_, wake_, thread_);
     if (writer_) writer_->waitForAcknowledgments(std::chrono::milliseconds(1000));
   }
   VerdictPublisher(const VerdictPublisher&) = delete;

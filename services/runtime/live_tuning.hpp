@@ -26,6 +26,7 @@
 #include "common/json_writer.hpp"
 #include "idl/msg_pubsub.hpp"
 #include "services/runtime/command_verdict.hpp"
+#include "services/runtime/process.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "services/runtime/topic_qos.hpp"
 
@@ -88,12 +89,7 @@ class LiveTuning {
   }
   ~LiveTuning() {
     reader_.reset();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    worker_.join();
+    stopWorker(mutex_, stop_, wake_, worker_);
     if (applied_writer_) applied_writer_->waitForAcknowledgments(std::chrono::milliseconds(1000));
   }
   LiveTuning(const LiveTuning&) = delete;

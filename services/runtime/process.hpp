@@ -3,7 +3,10 @@
 // scheduling with a graceful fallback, the readiness line the supervisor waits for, and the strict
 // command-line parser (common/command_line.hpp: unknown options are errors, every service has --help).
 #include <atomic>
+#include <condition_variable>
+#include <mutex>
 #include <string>
+#include <thread>
 
 #include "common/command_line.hpp"
 
@@ -16,6 +19,16 @@ void requestShutdown();
 // Returns once shutdown is requested (looked at every 10 ms): the main thread of a service whose work runs in
 // its DDS callbacks.
 void waitForShutdown();
+
+// Ends a worker thread that sleeps on `wake` until it has work or `stop` (set here under `mutex`), and joins it.
+inline void stopWorker(std::mutex& mutex, bool& stop, std::condition_variable& wake, std::thread& worker) {
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    stop = true;
+  }
+  wake.notify_all();
+  worker.join();
+}
 
 // Tries SCHED_FIFO at `priority` and mlockall; on failure prints a warning to stderr and carries on.
 // Returns true when both took effect. Call before creating the DDS participant so its threads inherit it.

@@ -26,7 +26,7 @@ def descriptors(r):
     for t in r.topics:
         slot = chain.index(t.type) if t.chain else -1
         rows.append(f'    {{"{t.type}", "{t.wire}", TopicQos::{QOS[t.qos]}, {slot}, {_bool(t.record)}, '
-                    f'{_bool(t.faults)}, {_bool(t.has_field("tick"))}}},')
+                    f'{_bool(t.faults)}, {_bool(t.has_field("tick"))}, "{",".join(t.subscribers())}"}},')
     of = "\n".join(f"template <>\nstruct TopicOf<{t.type}> {{\n  static constexpr int index = {i};\n}};"
                    for i, t in enumerate(r.topics))
     return (f"""enum class TopicQos : std::uint8_t {{ Chain, Event, Progress }};
@@ -39,11 +39,22 @@ struct TopicInfo {{
   bool recorded;
   bool faults;    // the fault matrix corrupts it; mft-inject --listen all
   bool has_tick;  // the message carries tick and stamp_ns (the others are events with a seq)
+  std::string_view readers;  // the identities that read it, comma-separated: its readers, and record if recorded
 }};
 inline constexpr std::array<TopicInfo, {len(r.topics)}> kTopics{{{{
 {chr(10).join(rows)}
 }}}};
 inline constexpr int kChainSlots = {len(chain)};
+
+// Whether `identity` (sim, estimator, planner, wbc, record, cmd: a service's name without "mft-") reads `t`.
+constexpr bool readBy(const TopicInfo& t, std::string_view identity) {{
+  for (std::string_view rest = t.readers; !rest.empty();) {{
+    const std::size_t comma = rest.find(',');
+    if (rest.substr(0, comma) == identity) return true;
+    rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+  }}
+  return false;
+}}
 
 // The row of a topic name, -1 if none.
 constexpr int topicIndex(std::string_view type) {{

@@ -276,6 +276,9 @@ class Stack:
         if args.record:
             names.append("mft-record")
         names.append("mft-sim")
+        # Every service announces the whole stack (all hosts) in DDS discovery: mft-cmd then waits for each reader
+        # of a request by name, the recorder included, even before it has discovered that reader's participant.
+        common += ["--stack-services", ",".join(names)]
         self.stack = getattr(args, "stack_file", None)
         self.only_host = getattr(args, "host", None)
         if self.only_host:

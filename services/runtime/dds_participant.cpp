@@ -2,11 +2,14 @@
 #include "services/runtime/topic_names.hpp"
 
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
 #include <fastdds/dds/log/Log.hpp>
 #include <fastrtps/xmlparser/XMLProfileManager.h>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -89,8 +92,54 @@ std::string checkProfilesFile(const std::string& profiles_file) {
   return "";
 }
 
+namespace {
+// The stack's services in a participant's user data: this prefix, then the names, comma-separated.
+constexpr const char kStackServicesTag[] = "mft-stack-services=";
+
+std::vector<std::string> stackServicesOf(const std::vector<eprosima::fastrtps::rtps::octet>& user_data) {
+  const std::string text(user_data.begin(), user_data.end());
+  std::vector<std::string> names;
+  if (text.rfind(kStackServicesTag, 0) != 0) return names;
+  for (std::size_t at = sizeof kStackServicesTag - 1; at <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    if (comma > at) names.push_back(text.substr(at, comma - at));
+    at = comma + 1;
+  }
+  return names;
+}
+}  // namespace
+
+// Keeps the participants discovered, on Fast DDS's discovery thread (never a service's tick path).
+class ParticipantDiscovery : public DomainParticipantListener {
+ public:
+  void on_participant_discovery(DomainParticipant*, eprosima::fastrtps::rtps::ParticipantDiscoveryInfo&& info) override {
+    using Info = eprosima::fastrtps::rtps::ParticipantDiscoveryInfo;
+    DiscoveredParticipant p;
+    std::memcpy(p.guid_prefix.data(), info.info.m_guid.guidPrefix.value, p.guid_prefix.size());
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = std::find_if(seen_.begin(), seen_.end(), [&](const auto& s) { return s.guid_prefix == p.guid_prefix; });
+    if (info.status == Info::REMOVED_PARTICIPANT || info.status == Info::DROPPED_PARTICIPANT) {
+      if (it != seen_.end()) it->present = false;
+      return;
+    }
+    p.name = info.info.m_participantName.c_str();
+    p.stack_services = stackServicesOf(info.info.m_userData.data_vec());
+    if (it == seen_.end()) seen_.push_back(std::move(p));
+    else *it = std::move(p);  // discovered again (its lease had expired), or its QoS changed
+  }
+  std::vector<DiscoveredParticipant> participants() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return seen_;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<DiscoveredParticipant> seen_;
+};
+
 DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
-                               const SecurityOptions& security, const ReceiveTuning& receive)
+                               const SecurityOptions& security, const ReceiveTuning& receive,
+                               const DiscoveryOptions& discovery)
     : domain_id_(checkedDomainId(domain_id)) {
   loadProfilesOnce(profiles_file);
   auto* factory = DomainParticipantFactory::get_instance();
@@ -100,7 +149,16 @@ DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, 
   qos.name(name);
   applyReceiveTuning(receive, &qos);
   applySecurity(security, &qos);
-  participant_ = factory->create_participant(domain_id_, qos);
+  if (!discovery.stack_services.empty()) {
+    const std::string text = kStackServicesTag + discovery.stack_services;
+    qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(text.begin(), text.end()));
+  }
+  if (discovery.keep_participants) {  // the listener from the start: the first peers answer within milliseconds
+    discovery_ = std::make_unique<ParticipantDiscovery>();
+    participant_ = factory->create_participant(domain_id_, qos, discovery_.get(), StatusMask::none());
+  } else {
+    participant_ = factory->create_participant(domain_id_, qos);
+  }
   if (!participant_)
     throw DdsError("cannot create a DDS participant on domain " + std::to_string(domain_id_) +
                    (security.enabled() ? " with the identity '" + security.identity + "' of " + security.dir +
@@ -113,8 +171,13 @@ DdsParticipant::DdsParticipant(int domain_id, const std::string& profiles_file, 
 
 DdsParticipant::~DdsParticipant() {
   if (!participant_) return;
+  if (discovery_) participant_->set_listener(nullptr);
   participant_->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(participant_);
+}
+
+std::vector<DiscoveredParticipant> DdsParticipant::discoveredParticipants() const {
+  return discovery_ ? discovery_->participants() : std::vector<DiscoveredParticipant>();
 }
 
 Topic* DdsParticipant::topic(const std::string& topic_name, TopicDataType* type) {

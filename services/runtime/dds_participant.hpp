@@ -7,6 +7,8 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include <array>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -49,14 +51,38 @@ int checkedDomainId(long domain_id);
 // messages, which name the element). Creates no participant.
 std::string checkProfilesFile(const std::string& profiles_file);
 
+// What a participant tells the others in discovery, and whether it keeps what it hears of them. The defaults
+// change nothing: a participant without them announces and listens exactly as before.
+struct DiscoveryOptions {
+  // The names of the stack's participants, comma-separated (the supervisor's --stack-services), announced in this
+  // participant's user data: a peer learns from any one member which services the stack has, including those it
+  // has not discovered yet (mft-cmd waits for every reader of its request, docs/operator-commands.md).
+  std::string stack_services;
+  // Keep the list of the participants discovered (discoveredParticipants()): a participant listener that runs on
+  // Fast DDS's discovery thread only. Tools (mft-cmd) turn it on; the services do not.
+  bool keep_participants = false;
+};
+
+// A participant seen in discovery.
+struct DiscoveredParticipant {
+  std::string name;                             // its qos.name ("mft-record"); empty if it gave none
+  std::array<std::uint8_t, 12> guid_prefix{};   // the first 12 bytes of the GUID of each of its endpoints
+  std::vector<std::string> stack_services;      // what it announced (DiscoveryOptions), empty if nothing
+  bool present = true;                          // false once it left or its lease expired
+};
+
+class ParticipantDiscovery;
+
 class DdsParticipant {
  public:
   // Loads `profiles_file` (throws if it is missing or malformed) and creates a participant with the
   // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery. With `security`
   // enabled the participant authenticates with that identity (docs/security.md).
   // `receive` tunes the receive path (socket buffer, polling; polling_udp_transport.hpp).
+  // `discovery`: what it announces and whether it keeps the participants it discovers (DiscoveryOptions).
   DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,
-                 const SecurityOptions& security = {}, const ReceiveTuning& receive = {});
+                 const SecurityOptions& security = {}, const ReceiveTuning& receive = {},
+                 const DiscoveryOptions& discovery = {});
   ~DdsParticipant();
   DdsParticipant(const DdsParticipant&) = delete;
   DdsParticipant& operator=(const DdsParticipant&) = delete;
@@ -68,6 +94,9 @@ class DdsParticipant {
   eprosima::fastdds::dds::Publisher* publisher() const { return publisher_; }
   eprosima::fastdds::dds::Subscriber* subscriber() const { return subscriber_; }
   int domainId() const { return domain_id_; }
+  // With DiscoveryOptions::keep_participants: every participant discovered since this one was created (a copy,
+  // taken under the listener's lock), in the order of discovery; empty otherwise.
+  std::vector<DiscoveredParticipant> discoveredParticipants() const;
   // Chain services only: the shared-memory channel their chain topics travel by (chain_channel.hpp).
   // TopicWriter/TopicReader with the chain's profiles (lockstep or realtime) use it when it is open.
   void openChainChannel(const std::string& name) { chain_channel_ = std::make_unique<ChainChannel>(name); }
@@ -81,6 +110,7 @@ class DdsParticipant {
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
   std::map<std::string, eprosima::fastdds::dds::TypeSupport> types_;
   std::unique_ptr<ChainChannel> chain_channel_;
+  std::unique_ptr<ParticipantDiscovery> discovery_;  // with keep_participants only
 };
 
 }  // namespace mft::services

@@ -25,6 +25,8 @@ void ServiceContext::declareOptions(CommandLine& cli) {
              "each host its own: its address, its peers or discovery server, docs/distributed.md)");
   cli.option("chain-shm", "chain services: also carry the chain's topics through this POSIX shared-memory "
              "segment (/mft-chain-…; the supervisor names one per stack; docs/loop-benchmark.md)");
+  cli.option("stack-services", "the names of the stack's services, comma-separated (the supervisor gives them): "
+             "announced in DDS discovery, so that mft-cmd waits for every reader of a request, the recorder included");
   cli.flag("check-config", "load every configuration file this service reads (strict loaders) and the DDS profile "
            "file (Fast DDS's XML loader), then exit: 0 and 'configuration ok', or 2 and the error; starts nothing");
 }
@@ -32,6 +34,13 @@ void ServiceContext::declareOptions(CommandLine& cli) {
 std::string ServiceContext::profilesFile(const CommandLine& cli) {
   const std::string file = cli.get("profiles");
   return file.empty() ? cli.get("config-dir") + "/dds_profiles.xml" : file;
+}
+
+std::string ServiceContext::stackServices(const CommandLine& cli) {
+  const std::string names = cli.get("stack-services");
+  if (names.size() > 200 || names.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789-,") != std::string::npos)
+    cli.fail("--stack-services: expected service names (a-z, 0-9, '-') separated by commas, at most 200 characters");
+  return names;
 }
 
 ServiceContext::ServiceContext(const std::string& service, const CommandLine& cli) : service_(service) {
@@ -62,7 +71,8 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   if (cli.isSet("rt")) tryRealtimeScheduling(static_cast<int>(cli.getInt("rt-priority", 1, 98)));
   try {
     participant_ = std::make_unique<DdsParticipant>(domain, profilesFile(cli), service,
-                                                    SecurityOptions{cli.get("secure"), securityIdentity(service)});
+                                                    SecurityOptions{cli.get("secure"), securityIdentity(service)},
+                                                    ReceiveTuning{}, DiscoveryOptions{stackServices(cli), false});
   } catch (const DdsError& e) {
     cli.fail(e.what());
   }

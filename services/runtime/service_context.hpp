@@ -23,6 +23,8 @@ class ServiceContext {
   static void declareOptions(CommandLine& cli);
   // The DDS profile file of a parsed command line: --profiles, else dds_profiles.xml of --config-dir.
   static std::string profilesFile(const CommandLine& cli);
+  // --stack-services, checked (cli.fail on anything but names and commas); "" when not given.
+  static std::string stackServices(const CommandLine& cli);
   // After cli.parse(): loads the configuration and creates the participant. Exits 2 with a clear message on
   // any configuration error (nothing is started). With --check-config it creates no participant but checks
   // the DDS profile file with Fast DDS's XML loader instead.

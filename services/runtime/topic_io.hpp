@@ -136,6 +136,12 @@ class TopicWriter : public eprosima::fastdds::dds::DataWriterListener {
     return outside_readers_.load();
   }
   int ddsMatched() const { return matched_.load(); }  // every matched DDS reader, the chain's listeners included
+  // The GUIDs of the matched DDS readers (a copy; for tools: it takes the match lock). The first 12 bytes of each
+  // are its participant's GUID prefix.
+  std::vector<ChainChannel::EndpointId> matchedReaders() const {
+    std::lock_guard<std::mutex> lock(matched_mutex_);
+    return matched_readers_;
+  }
   bool viaChainChannel() const { return shm_ != nullptr; }
   std::uint64_t offeredDeadlineMisses() const { return offered_deadline_misses_.load(); }
 

@@ -15,8 +15,10 @@ namespace mft::cmd {
 
 using Clock = std::chrono::steady_clock;
 
-// Exit statuses (also in --help).
-constexpr int kAccepted = 0, kRejected = 1, kUsage = 2, kNoStack = 3, kNotAcknowledged = 4, kNoVerdict = 5;
+// Exit statuses (also in --help). kNotDelivered: the verdict is as reported, but a service that reads the topic
+// (the recorder, say) did not acknowledge the request (delivery.hpp).
+constexpr int kAccepted = 0, kRejected = 1, kUsage = 2, kNoStack = 3, kNotAcknowledged = 4, kNoVerdict = 5,
+              kNotDelivered = 6;
 
 // A number with `digits` decimals (fixed) or significant digits (general, digits < 0 means -digits).
 std::string fmt(double a, int digits);
@@ -43,12 +45,14 @@ struct Verdict {
 Verdict verdictOf(const msg::CommandVerdict& m, Clock::time_point written_at);
 
 // exchange(participant) on the stack's domain with the --profiles, --secure and --identity options; a DDS set-up
-// error ends as finish(kUsage, "error", its message).
+// error ends as finish(kUsage, "error", its message). The participant keeps the participants it discovers: the
+// delivery check (delivery.hpp) needs to know who should read a request.
 template <typename Exchange, typename Finish>
 int withParticipant(const config::CommandLine& cli, int domain, Exchange exchange, Finish finish) {
   try {
     services::DdsParticipant participant(domain, cli.get("profiles"), "mft-cmd",
-                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")});
+                                         services::SecurityOptions{cli.get("secure"), cli.get("identity")},
+                                         services::ReceiveTuning{}, services::DiscoveryOptions{"", true});
     return exchange(participant);
   } catch (const services::DdsError& e) {
     return finish(kUsage, "error", e.what());

@@ -14,6 +14,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "tools/mft-cmd/cmd_common.hpp"
+#include "tools/mft-cmd/delivery.hpp"
 
 namespace mft::cmd {
 
@@ -24,6 +25,7 @@ struct Change {
   std::uint8_t source = 0;
   msg::ConfigChange msg;
   std::vector<Verdict> verdicts;
+  Reach reach;  // which of the stack's readers acknowledged it
   std::string result = "no_verdict";
   int code = kNoVerdict;
 };
@@ -86,7 +88,17 @@ class LiveSet {
   using Writer = services::TopicWriter<msg::ConfigChange, msg::ConfigChangePubSubType>;
 
   // One line on stderr (and the JSON object on stdout with --json) for every outcome.
-  int finish(int code, const std::string& result, const std::string& error) {
+  int finish(int code, const std::string& result, std::string error) {
+    if (!changes_.empty() && changes_.front().reach.known) acknowledged_ = true;  // recounted below
+    for (auto& c : changes_) {
+      if (!c.verdicts.empty()) c.reach.confirmedBy(c.answerer);  // its verdict proves it has the change
+      if (c.reach.known) acknowledged_ = acknowledged_ && c.reach.complete();
+      if ((code == kAccepted || code == kRejected || code == kNotDelivered) && !c.reach.complete()) {
+        code = kNotDelivered;
+        error += (error.empty() ? "" : "; ") + c.file + "." + c.key + " (seq " + std::to_string(c.msg.seq()) +
+                 ") did not reach every reader of the stack: " + c.reach.missedText();
+      }
+    }
     if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
     if (x_.json) {
       config::JsonWriter w;
@@ -94,6 +106,7 @@ class LiveSet {
       w.field("readers_matched", matched_).field("acknowledged", acknowledged_).key("changes").beginArray();
       for (const auto& c : changes_) {
         w.beginObject().field("file", c.file).field("key", c.key).field("value", c.value).field("seq", c.msg.seq());
+        c.reach.writeJson(w);
         w.field("answered_by", c.answerer).key("verdicts");
         writeVerdicts(w, c.verdicts);
         w.field("result", c.result).endObject();
@@ -133,20 +146,40 @@ class LiveSet {
       return finish(kNoStack, "no_stack",
                     "no stack answered on domain " + std::to_string(x_.domain) + " within " + fmt(x_.timeout_s, -6) +
                         " s (no reader of ConfigChange; is the stack up on this domain?)");
-    acknowledged_ = true;  // every write's acknowledgement, below
     for (std::size_t i = 0; i < changes_.size(); ++i) {
       written_at_[i] = Clock::now();
       if (!writers[i]->write(changes_[i].msg)) return finish(kUsage, "error", "the DDS writer refused the ConfigChange");
     }
-    for (const auto& w : writers) acknowledged_ = w->waitForAcknowledgments(x_.timeout) && acknowledged_;
+    deliver(participant, writers);
     matched_ = writers.front()->matched();
     if (!x_.json) {
       std::printf("mft-cmd: %zu ConfigChange(s) (%s) written to %d reader(s) on domain %d, %s\n", changes_.size(),
                   at_s_ > 0 ? ("at t = " + fmt(at_s_, 3) + " s").c_str() : "at the next tick", matched_, x_.domain,
-                  acknowledged_ ? "acknowledged" : "NOT acknowledged yet");
+                  ackText().c_str());
       std::fflush(stdout);
     }
     return awaitVerdicts();
+  }
+
+  // Every reader the stack has (the recorder included) must acknowledge every change within --timeout.
+  void deliver(const services::DdsParticipant& participant, const std::vector<std::unique_ptr<Writer>>& writers) {
+    std::vector<std::unique_ptr<WriterAcks<Writer>>> acks;
+    std::vector<AckSource*> sources;
+    for (const auto& w : writers) sources.push_back(acks.emplace_back(std::make_unique<WriterAcks<Writer>>(*w)).get());
+    const std::vector<Reach> reaches = awaitDelivery(participant, "ConfigChange", sources, written_at_.back() + x_.timeout);
+    acknowledged_ = true;
+    for (std::size_t i = 0; i < changes_.size(); ++i) {
+      changes_[i].reach = reaches[i];
+      acknowledged_ = acknowledged_ && reaches[i].complete();
+    }
+  }
+
+  std::string ackText() const {
+    if (acknowledged_) return changes_.front().reach.ackText();
+    std::string text;
+    for (const auto& c : changes_)
+      if (!c.reach.complete()) text += (text.empty() ? "" : "; ") + ("seq " + std::to_string(c.msg.seq()) + " ") + c.reach.ackText();
+    return text;
   }
 
   int awaitVerdicts() {
@@ -156,17 +189,23 @@ class LiveSet {
       const bool open = takeVerdicts();
       std::fflush(stdout);
       if (!open || Clock::now() > deadline) break;
-      if (!acknowledged_ && Clock::now() > written_at_.back() + x_.timeout) {
+      if (answererMissed() && Clock::now() > written_at_.back() + x_.timeout) {
         bool any = false;
         for (const auto& c : changes_) any = any || !c.verdicts.empty();
         if (!any)
           return finish(kNotAcknowledged, "not_acknowledged",
-                        "the " + std::to_string(matched_) + " reader(s) of ConfigChange on domain " +
-                            std::to_string(x_.domain) + " did not acknowledge within " + fmt(x_.timeout_s, -6) + " s");
+                        "the readers of ConfigChange on domain " + std::to_string(x_.domain) +
+                            " did not acknowledge within " + fmt(x_.timeout_s, -6) + " s: " + ackText());
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return conclude();
+  }
+
+  bool answererMissed() const {
+    for (const auto& c : changes_)
+      if (c.reach.missedBy(c.answerer)) return true;
+    return false;
   }
 
   // Reports the verdicts that arrived since the last call; true while a change is still open.

@@ -1,7 +1,8 @@
 // mft-cmd: sends an operator command (height, speed, mode) or a disturbance (a sagittal push) to a running
 // stack and reports the stack's verdict (docs/operator-commands.md): it waits until a reader of the stack has
-// matched its writer (reliable, transient local), until the readers have acknowledged the sample, and until
-// the planner (commands) or the simulator (pushes) has answered on CommandVerdict with the command's seq.
+// matched its writer (reliable, transient local), until every service that reads the topic (the recorder included)
+// has acknowledged the sample, and until the planner (commands) or the simulator (pushes) has answered on
+// CommandVerdict with the command's seq.
 // The exit status says what happened; nothing is reported as done that the stack did not confirm.
 #include "common/tool_io.hpp"
 #include "services/runtime/process.hpp"
@@ -24,10 +25,13 @@ static int toolMain(int argc, char** argv) {
       "config/planner.yaml (mft-planner) while the stack runs, judged by that file's strict loader; a lockstep stack\n"
       "takes it at a stated simulated time only (--at), a realtime one at the next tick without --at\n"
       "(docs/live-tuning.md). Several --set: one change each, in order; the exit status is the worst.\n"
+      "Every service of the stack that reads the topic (the recorder too) must acknowledge the request within\n"
+      "--timeout; those that did not are named.\n"
       "Exit status: 0 accepted (applied, or scheduled by the stack); 1 rejected by the stack (the reason is\n"
       "printed); 2 usage, input or DDS set-up error; 3 no stack answered on the domain within --timeout (no\n"
-      "reader matched); 4 the readers did not acknowledge the command within --timeout; 5 no verdict within\n"
-      "--verdict-timeout.");
+      "reader matched); 4 the answering service did not acknowledge the command within --timeout; 5 no verdict\n"
+      "within --verdict-timeout; 6 answered as printed (applied, scheduled or rejected), but another service\n"
+      "that reads the topic did not acknowledge it within --timeout (named; e.g. the recording lacks it).");
   cli.option("domain", "DDS domain id of the stack (0..232)", "0");
   cli.option("mode", "stand | step_in_place | walk (an operator command)");
   cli.option("height", "base height command [m] (the planner accepts its reachable range)", "0.42");
@@ -38,7 +42,8 @@ static int toolMain(int argc, char** argv) {
   cli.option("set", "FILE.KEY=VALUE: change a tunable key of config/FILE.yaml (wbc or planner) while the stack runs, "
              "e.g. wbc.weights.slack=1e5 or wbc.gains.swing_foot.kp=[300,300] (repeatable)");
   cli.option("seq", "sequence number of the command, echoed by its verdict (default: from the clock and pid)");
-  cli.option("timeout", "seconds to wait for a reader of the stack to match, and again for the acknowledgement", "5");
+  cli.option("timeout", "seconds to wait for a reader of the stack to match, and again for every service that reads "
+             "the topic to match and acknowledge", "5");
   cli.option("verdict-timeout", "seconds to wait for the stack's verdict once the command is written", "10");
   cli.flag("accepted-only", "return at the first acceptance (scheduled) instead of waiting until it is applied");
   cli.option("profiles", "DDS QoS profile file",

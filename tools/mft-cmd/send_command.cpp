@@ -12,6 +12,7 @@
 #include "services/runtime/dds_participant.hpp"
 #include "services/runtime/topic_io.hpp"
 #include "tools/mft-cmd/cmd_common.hpp"
+#include "tools/mft-cmd/delivery.hpp"
 
 namespace mft::cmd {
 
@@ -92,13 +93,22 @@ class CommandSend {
 
  private:
   // One line on stderr (and the JSON object on stdout with --json) for every outcome.
-  int finish(int code, const std::string& result, const std::string& error) {
+  int finish(int code, const std::string& result, std::string error) {
+    if (!verdicts_.empty()) reach_.confirmedBy(out_.answerer);  // its verdict proves it has the command
+    if (reach_.known) acknowledged_ = reach_.complete();
+    if ((code == kAccepted || code == kRejected) && !reach_.complete()) {
+      code = kNotDelivered;
+      error += (error.empty() ? "" : "; ") + out_.topic + " seq " + std::to_string(seq_) +
+               " did not reach every reader of the stack: " + reach_.missedText();
+    }
     if (!error.empty()) std::fprintf(stderr, "mft-cmd: %s\n", error.c_str());
     if (x_.json) {
       config::JsonWriter w;
       w.beginObject().field("command", out_.topic).field("seq", seq_).field("domain", x_.domain);
       out_.writeWhat(w);
-      w.field("readers_matched", matched_).field("acknowledged", acknowledged_).field("answered_by", out_.answerer);
+      w.field("readers_matched", matched_).field("acknowledged", acknowledged_);
+      reach_.writeJson(w);
+      w.field("answered_by", out_.answerer);
       w.key("verdicts");
       writeVerdicts(w, verdicts_);
       w.field("result", result).field("exit_code", code).field("error", error);
@@ -135,16 +145,23 @@ class CommandSend {
     written_at_ = Clock::now();
     const bool written = has_cmd ? command_writer->write(out_.command) : push_writer->write(out_.push);
     if (!written) return finish(kUsage, "error", "the DDS writer refused the " + out_.topic);
-    acknowledged_ = has_cmd ? command_writer->waitForAcknowledgments(x_.timeout)
-                            : push_writer->waitForAcknowledgments(x_.timeout);
+    // Every reader the stack has (the recorder included) must acknowledge it within --timeout (delivery.hpp).
+    reach_ = has_cmd ? deliver(participant, *command_writer) : deliver(participant, *push_writer);
+    acknowledged_ = reach_.complete();
     matched_ = readers();
     if (!x_.json) {
       std::printf("mft-cmd: %s seq %llu (%s) written to %d reader(s) on domain %d, %s\n", out_.topic.c_str(),
                   static_cast<unsigned long long>(seq_), out_.what_text.c_str(), matched_, x_.domain,
-                  acknowledged_ ? "acknowledged" : "NOT acknowledged yet");
+                  reach_.ackText().c_str());
       std::fflush(stdout);
     }
     return awaitVerdict();
+  }
+
+  template <class Writer>
+  Reach deliver(const services::DdsParticipant& participant, Writer& writer) {
+    WriterAcks<Writer> acks(writer);
+    return awaitDelivery(participant, out_.topic, {&acks}, written_at_ + x_.timeout).front();
   }
 
   // The verdicts: rejected, or scheduled then applied.
@@ -171,11 +188,11 @@ class CommandSend {
       }
       if (scheduled && x_.accepted_only) return finish(kAccepted, "scheduled", "");
       if (Clock::now() > verdict_deadline) break;
-      if (!acknowledged_ && !scheduled && Clock::now() > written_at_ + x_.timeout)
+      if (reach_.missedBy(out_.answerer) && !scheduled && Clock::now() > written_at_ + x_.timeout)
         return finish(kNotAcknowledged, "not_acknowledged",
-                      "the " + std::to_string(matched_) + " reader(s) of " + out_.topic + " on domain " +
-                          std::to_string(x_.domain) + " did not acknowledge seq " + seq + " within " +
-                          fmt(x_.timeout_s, -6) + " s");
+                      "the readers of " + out_.topic + " on domain " + std::to_string(x_.domain) +
+                          " did not acknowledge seq " + seq + " within " + fmt(x_.timeout_s, -6) +
+                          " s: " + reach_.missedText());
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     if (scheduled) {
@@ -196,6 +213,7 @@ class CommandSend {
   const Outgoing out_;
   int matched_ = 0;
   bool acknowledged_ = false;
+  Reach reach_;
   std::mutex mutex_;
   std::vector<Verdict> received_, verdicts_;
   Clock::time_point written_at_ = Clock::now();

@@ -1,5 +1,6 @@
 #include "tools/mft-cmd/live_set.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -174,11 +175,13 @@ class LiveSet {
     }
   }
 
+  // One text when every change reached the same services (the usual case), else one per change.
   std::string ackText() const {
-    if (acknowledged_) return changes_.front().reach.ackText();
+    const std::string first = changes_.front().reach.ackText();
+    const bool same = std::all_of(changes_.begin(), changes_.end(), [&](const Change& c) { return c.reach.ackText() == first; });
+    if (same) return first;
     std::string text;
-    for (const auto& c : changes_)
-      if (!c.reach.complete()) text += (text.empty() ? "" : "; ") + ("seq " + std::to_string(c.msg.seq()) + " ") + c.reach.ackText();
+    for (const auto& c : changes_) text += (text.empty() ? "" : "; ") + ("seq " + std::to_string(c.msg.seq()) + " ") + c.reach.ackText();
     return text;
   }
 

@@ -185,6 +185,20 @@ void checkLiveValue(const std::string& stem, const std::string& key, const std::
   }
 }
 
+SetItem parseSetItem(const std::string& item, std::size_t max_chars) {
+  const std::string origin = "--set '" + item + "'";
+  const auto eq = item.find('='), dot = item.find('.');
+  if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq)
+    throw ConfigError(origin + ": expected FILE.KEY=VALUE, e.g. wbc.weights.slack=1e5");
+  SetItem s{item.substr(0, dot), item.substr(dot + 1, eq - dot - 1), item.substr(eq + 1)};
+  if (s.file != "wbc" && s.file != "planner")
+    throw ConfigError(origin + ": '" + s.file + "' is not a live-tunable file (wbc or planner)");
+  if (s.value.empty()) throw ConfigError(origin + ": no value after '='");
+  if (s.key.size() >= max_chars || s.value.size() >= max_chars)
+    throw ConfigError(origin + ": key and value must be shorter than " + std::to_string(max_chars) + " characters each");
+  return s;
+}
+
 void requireTunable(const std::string& stem, const std::string& key, const std::string& origin) {
   if (tunableIndex(stem, key) < 0)
     throw ConfigError(origin + ": " + key + ": not tunable while the stack runs (tunable: " + describeTunable(stem) + ")");

@@ -47,6 +47,12 @@ struct ConfigOverride {
 // refused). Anything else is left to the answering service's loader. Throws ConfigError naming `origin`.
 void checkLiveValue(const std::string& stem, const std::string& key, const std::string& value_yaml,
                     const std::string& origin);
+// One `mft-cmd --set` item, FILE.KEY=VALUE, taken apart: FILE is wbc or planner, KEY and VALUE are non-empty and
+// shorter than `max_chars` each (they travel in fixed-size text fields). Throws ConfigError naming the item.
+struct SetItem {
+  std::string file, key, value;
+};
+SetItem parseSetItem(const std::string& item, std::size_t max_chars);
 // Refuses a `key` of file `stem` that is not tunable live (ConfigError naming the tunable keys).
 void requireTunable(const std::string& stem, const std::string& key, const std::string& origin);
 // Sets `key` to `value_yaml` in `yaml_text` (named `origin` in messages), reads the result with `load(text,

@@ -10,6 +10,7 @@ PACKAGES=(
   cyclonedds-dev cyclonedds-tools
   libmrpt-obs-dev libmrpt-io-dev mrpt-apps
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-dev    # scripts/fuzz.sh only (libFuzzer, ASan, UBSan); the build itself uses GCC
   python3 python3-yaml python3-matplotlib python3-distributed
   ffmpeg
   iproute2 nftables

@@ -33,27 +33,22 @@ struct Change {
 
 // FILE.KEY=VALUE to a change with its seq; a malformed item is a usage error naming it.
 Change parseChange(const config::CommandLine& cli, const std::string& item, std::uint64_t seq, double at_s) {
-  const auto eq = item.find('='), dot = item.find('.');
-  if (eq == std::string::npos || dot == std::string::npos || dot > eq || dot == 0 || dot + 1 == eq)
-    cli.fail("--set '" + item + "': expected FILE.KEY=VALUE, e.g. wbc.weights.slack=1e5");
   Change c;
-  c.file = item.substr(0, dot);
-  c.key = item.substr(dot + 1, eq - dot - 1);
-  c.value = item.substr(eq + 1);
+  try {
+    const config::SetItem s = config::parseSetItem(item, c.msg.key().size());
+    c.file = s.file, c.key = s.key, c.value = s.value;
+  } catch (const config::ConfigError& e) {
+    cli.fail(e.what());
+  }
   if (c.file == "wbc") {
     c.answerer = "mft-wbc";
     c.source = msg::COMMAND_SOURCE_WBC;
     c.msg.target(msg::CONFIG_TARGET_WBC);
-  } else if (c.file == "planner") {
+  } else {
     c.answerer = "mft-planner";
     c.source = msg::COMMAND_SOURCE_PLANNER;
     c.msg.target(msg::CONFIG_TARGET_PLANNER);
-  } else {
-    cli.fail("--set '" + item + "': '" + c.file + "' is not a live-tunable file (wbc or planner)");
   }
-  if (c.value.empty()) cli.fail("--set '" + item + "': no value after '='");
-  if (c.key.size() >= c.msg.key().size() || c.value.size() >= c.msg.value().size())
-    cli.fail("--set '" + item + "': key and value must be shorter than 64 characters each");
   c.msg.seq(seq);
   std::snprintf(c.msg.key().data(), c.msg.key().size(), "%s", c.key.c_str());
   std::snprintf(c.msg.value().data(), c.msg.value().size(), "%s", c.value.c_str());

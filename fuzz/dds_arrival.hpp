@@ -7,6 +7,7 @@
 
 #include "chain/actuator_driver.hpp"
 #include "chain/input_guard.hpp"
+#include "common/strict_yaml.hpp"
 #include "fuzz/config_files.hpp"
 #include "planner/planner_config.hpp"
 #include "planner/planner_tuning.hpp"

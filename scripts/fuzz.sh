@@ -10,11 +10,12 @@ cd "$(dirname "$0")/.."
 TARGETS=(rawlog config scenario qp set dds_sample)
 usage() {
   cat <<USAGE
-usage: scripts/fuzz.sh TARGET SECONDS [--keep-going] [--json]
+usage: scripts/fuzz.sh TARGET SECONDS [--keep-going] [--no-build] [--json]
        scripts/fuzz.sh --list | --help
 Builds fuzz_TARGET with clang, -fsanitize=fuzzer,address,undefined (build/fuzz) and fuzzes it for SECONDS.
 New interesting inputs go to build/fuzz/corpus/TARGET, crashers to build/fuzz/crashes/TARGET/, the log to
 build/fuzz/logs/TARGET.log. At the end: seconds, executions, corpus size, coverage (cov, ft) and findings;
+--no-build: run build/fuzz/fuzz/fuzz_TARGET as it is (another build of build/fuzz is running).
 --keep-going: libFuzzer's fork mode, which keeps fuzzing after a crash or hang (each crasher kept) for the whole
 time. --json prints the figures as one JSON object. Exit status: 0 nothing found, 1 a finding, 2 bad usage or build failure.
 Targets: ${TARGETS[*]}
@@ -24,12 +25,14 @@ fail() { echo "fuzz.sh: $*" >&2; exit 2; }
 
 json=0
 keep_going=()
+build_it=1
 args=()
 for a in "$@"; do
   case "$a" in
     --help|-h) usage; exit 0 ;;
     --list) printf '%s\n' "${TARGETS[@]}"; exit 0 ;;
     --json) json=1 ;;
+    --no-build) build_it=0 ;;
     --keep-going) keep_going=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1) ;;
     -*) fail "unknown option '$a' (see --help)" ;;
     *) args+=("$a") ;;
@@ -46,15 +49,19 @@ command -v clang++ >/dev/null || fail "clang++ not found: bash scripts/install-d
   fail "libFuzzer not found: bash scripts/install-deps.sh installs libclang-rt-dev"
 
 build=build/fuzz
-if [ ! -f "$build/build.ninja" ]; then
+if [ $build_it -eq 0 ]; then
+  [ -x "$build/fuzz/fuzz_$target" ] || fail "--no-build: $build/fuzz/fuzz_$target is not built"
+elif [ ! -f "$build/build.ninja" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
     -DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
     -DMFT_FUZZ=ON -DMFT_BUILD_TESTS=OFF -DMFT_BUILD_BENCH=OFF >/dev/null || fail "configuring $build failed"
 fi
-cmake --build "$build" -j "${MFT_BUILD_JOBS:-$(nproc)}" --target "fuzz_$target" >"$build/build-$target.log" 2>&1 || {
-  tail -20 "$build/build-$target.log" >&2; fail "building fuzz_$target failed (log: $build/build-$target.log)"; }
+if [ $build_it -eq 1 ]; then
+  cmake --build "$build" -j "${MFT_BUILD_JOBS:-$(nproc)}" --target "fuzz_$target" >"$build/build-$target.log" 2>&1 || {
+    tail -20 "$build/build-$target.log" >&2; fail "building fuzz_$target failed (log: $build/build-$target.log)"; }
+fi
 
 work="$build/corpus/$target"
 crashes="$build/crashes/$target"

@@ -7,7 +7,7 @@ import sys
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent / "tools" / "mft-experiment"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftexp import cli  # noqa: E402
 
 

@@ -5,7 +5,7 @@ import sys
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tools" / "mft-experiment"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftexp.wilson import Z95, bootstrap, crossing, curve, wilson  # noqa: E402
 from mftexp.recovery_report import first_failure_imax  # noqa: E402
 from mftexp.recovery_map import phase_points, impulse_grid, run_scenario_dict  # noqa: E402

@@ -10,7 +10,7 @@ import tempfile
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent / "tools" / "mft-experiment"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftexp import common  # noqa: E402
 
 FAKE_SUPERVISOR = r'''

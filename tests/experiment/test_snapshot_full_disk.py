@@ -24,7 +24,6 @@ class SnapshotFullDisk(unittest.TestCase):
         (work / "out").mkdir()
         code = textwrap.dedent(f"""
             import sys
-            sys.path.insert(0, {str(ROOT / "tools" / "mft-experiment")!r})
             sys.path.insert(0, {str(ROOT / "python")!r})
             from mftexp import common
             try:

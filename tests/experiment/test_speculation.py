@@ -13,7 +13,7 @@ import time
 import unittest
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent.parent / "tools" / "mft-experiment"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftexp import push as pushmod  # noqa: E402
 from mftexp.common import REGISTRY, DEFAULT_CONFIG, Interrupted  # noqa: E402
 from mftexp.executor import RunResult  # noqa: E402

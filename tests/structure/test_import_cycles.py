@@ -8,7 +8,7 @@ import unittest
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-PACKAGES = [ROOT / "python" / "mftstack", ROOT / "tools" / "mft-experiment" / "mftexp"]
+PACKAGES = [ROOT / "python" / "mftstack", ROOT / "python" / "mftexp"]
 
 
 def module_graph(package_dir):

@@ -282,7 +282,7 @@ def add_worker_command(sub):
     w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/experiments.md)",
                        description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "
                                    "its services (--bin-dir) as the binaries of every run; runs until stopped "
-                                   "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/tools/mft-experiment "
+                                   "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/python "
                                    "MFT_BIN_DIR=BIN dask-worker SCHEDULER --nthreads N. Each run takes a DDS domain "
                                    "that no other run on this machine holds (lock files in MFT_EXPERIMENT_SCRATCH, "
                                    "default TMPDIR/mft-experiment-worker).",
@@ -340,10 +340,9 @@ def cmd_worker(args):
     check_setup(args.bin_dir, DEFAULT_CONFIG)
     if args.nthreads < 1:
         raise ExperimentError("--nthreads must be at least 1")
-    tool_dir = str(Path(__file__).resolve().parent.parent)
     # No statistical profiler (it samples every thread each 10 ms, on cores the stacks need).
     env = dict(os.environ, MFT_BIN_DIR=str(Path(args.bin_dir).resolve()), DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED="False",
-               PYTHONPATH=os.pathsep.join([tool_dir, str(REPO / "python")] +
+               PYTHONPATH=os.pathsep.join([str(REPO / "python")] +
                                           [p for p in [os.environ.get("PYTHONPATH")] if p]))
     extra = list(args.dask_args)
     argv = [sys.executable, "-m", "distributed.cli.dask_worker", args.scheduler, "--nthreads", str(args.nthreads),

@@ -179,7 +179,7 @@ class DaskExecutor:
             answers = self.client.run(_probe_worker, self.identity)
         except Exception as e:  # noqa: a worker that cannot import mftexp raises ModuleNotFoundError here
             raise ExperimentError(f"a Dask worker could not check its build: {type(e).__name__}: {e} (start workers "
-                                  f"with 'mft-experiment worker {self.address}' or PYTHONPATH=REPO/tools/mft-experiment)")
+                                  f"with 'mft-experiment worker {self.address}' or PYTHONPATH=REPO/python)")
         bad = [f"{addr}: {a['problem']}" for addr, a in sorted(answers.items()) if a.get("problem")]
         if bad:
             raise ExperimentError("Dask worker(s) refuse this study: " + " | ".join(bad))

@@ -58,7 +58,7 @@ def probe(client_identity):
         problem = f"its build differs: {problem}"
     else:
         try:
-            check_setup(bin_dir(), Path(__file__).resolve().parents[3] / "config")
+            check_setup(bin_dir(), Path(__file__).resolve().parents[2] / "config")
         except ExperimentError as e:
             problem = str(e)
     return {"problem": problem, "host": socket.gethostname(), "bin_dir": str(bin_dir())}
@@ -148,7 +148,7 @@ def run_task(task):
         raise BuildMismatch(f"Dask worker {name} on {socket.gethostname()} refuses: its build differs from the "
                             f"client's: {problem} (check out and build the client's commit there)", name)
     try:
-        check_setup(bin_dir(), Path(__file__).resolve().parents[3] / "config",
+        check_setup(bin_dir(), Path(__file__).resolve().parents[2] / "config",
                     need=("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") +
                          (("mft-record",) if task["record"] else ()) +
                          (("mft-closedloop",) if task["inprocess"] else ()))

@@ -1,7 +1,7 @@
 #pragma once
 // The one mapping from the planner's output to the WBC's reference (the content of the Reference topic).
 // Header-only and plain data on both sides, so the DDS services (through msg::Reference) and the in-process
-// closed loop (tools/closedloop) hand the controller exactly the same numbers. It lives in chain/, the floor
+// closed loop (chain/closed_loop.hpp) hand the controller exactly the same numbers. It lives in chain/, the floor
 // that joins the planner and the controller: wbc/ depends on model/ alone.
 #include "planner/plan_output.hpp"
 #include "wbc/wbc_reference.hpp"

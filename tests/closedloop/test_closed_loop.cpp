@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "tools/closedloop/closed_loop.hpp"
+#include "chain/closed_loop.hpp"
 
 namespace mft::closedloop {
 namespace {

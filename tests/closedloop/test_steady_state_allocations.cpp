@@ -17,6 +17,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "chain/closed_loop.hpp"
 #include "chain/estimator_node.hpp"
 #include "chain/planner_node.hpp"
 #include "chain/sim_node.hpp"
@@ -24,7 +25,6 @@
 #include "idl/msg_pubsub.hpp"
 #include "idl/msg_types.hpp"
 #include "services/runtime/topic_io.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 
 extern "C" void* __libc_malloc(std::size_t);
 extern "C" void* __libc_calloc(std::size_t, std::size_t);

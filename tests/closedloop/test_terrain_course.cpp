@@ -16,12 +16,12 @@
 #include <string>
 #include <vector>
 
+#include "chain/closed_loop.hpp"
 #include "chain/scenario.hpp"
 #include "model/coordinates.hpp"
 #include "model/five_bar.hpp"
 #include "sim/simulator.hpp"
 #include "sim/terrain.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 
 namespace mft::closedloop {
 namespace {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "chain/closed_loop.hpp"
 #include "chain/scenario.hpp"
 #include "common/config_schema.hpp"
 #include "common/json_writer.hpp"
@@ -18,7 +19,6 @@
 #include "planner/planner_config.hpp"
 #include "planner/planner_tuning.hpp"
 #include "sim/terrain.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 
 namespace mft {
 namespace {

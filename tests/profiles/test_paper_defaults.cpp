@@ -7,8 +7,8 @@
 
 #include <cmath>
 
+#include "chain/closed_loop.hpp"
 #include "model/mft_raci.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 #include "wbc/whole_body_controller.hpp"
 
 namespace mft {

@@ -8,11 +8,11 @@
 #include <sstream>
 #include <string>
 
+#include "chain/closed_loop.hpp"
 #include "common/profiles.hpp"
 #include "common/strict_yaml.hpp"
 #include "tests/support/config_test_support.hpp"
 #include "chain/scenario.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 
 namespace mft {
 namespace {

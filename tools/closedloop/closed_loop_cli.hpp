@@ -6,8 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include "chain/closed_loop.hpp"
 #include "common/command_line.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 
 namespace mft::closedloop {
 

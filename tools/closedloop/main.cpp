@@ -8,9 +8,9 @@
 #include <cstdio>
 #include <memory>
 
+#include "chain/closed_loop.hpp"
 #include "common/command_line.hpp"
 #include "common/tool_io.hpp"
-#include "tools/closedloop/closed_loop.hpp"
 #include "tools/closedloop/closed_loop_cli.hpp"
 
 using namespace mft;

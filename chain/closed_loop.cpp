@@ -1,4 +1,4 @@
-#include "tools/closedloop/closed_loop.hpp"
+#include "chain/closed_loop.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common/json_writer.hpp"
 #include "common/profiles.hpp"
-#include "common/tool_io.hpp"
 
 namespace mft::closedloop {
 namespace {

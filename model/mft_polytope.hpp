@@ -29,12 +29,15 @@ struct MftLegPolygon {
   static MftLegPolygon fromHalfPlanes(const HalfPlanePolygon& p);
 };
 
-struct MftFitSummary {
+// How a polytope is fitted (mft-space's defaults), and what the fit gave.
+struct MftFitSettings {
   double joint_step_rad = 0.01;
   double cartesian_step_m = 0.01;
   int edges = kMftLegEdges;
   int starts = 24;
   unsigned rng_seed = 1;
+};
+struct MftFitSummary : MftFitSettings {
   double area_rad2 = 0.0;
   double coverage = 0.0;        // fraction of preferable joint-grid nodes inside the polygon
   double r_max_rad = 0.0;       // condition 2: largest distance of an uncovered preferable node to the polygon

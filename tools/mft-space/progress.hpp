@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <string>
 
+#include "model/mft_space_fit.hpp"
+
 namespace mft::tools {
 
 class Progress {
@@ -18,6 +20,11 @@ class Progress {
     const int q = 4 * done / total;
     if (done == total || q != 4 * (done - 1) / total)
       std::fprintf(stderr, "[mft-space %6.2fs]   %s %3d%%\n", seconds(), what.c_str(), 100 * done / total);
+  }
+  // The pipeline's reports (model::fitMftSpace) through this object.
+  model::MftSpaceProgress callbacks() {
+    return {[this](const std::string& what) { stage(what); },
+            [this](const std::string& what, int done, int total) { percent(what, done, total); }};
   }
   double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count(); }
 

@@ -14,6 +14,7 @@
 #include "common/tool_io.hpp"
 #include "figure.hpp"
 #include "json_writer.hpp"
+#include "progress.hpp"
 #include "space_run.hpp"
 #include "stance_table.hpp"
 #include "violation_table.hpp"
@@ -82,8 +83,8 @@ int cmdFit(int argc, char** argv) {
   const CliArgs a(argc, argv, 2, withSpaceOptions({"robot", "output"}), flagsWith({"gravity"}));
   Progress progress(a.flag("quiet"));
   const RobotDescription robot = loadRobotDescription(a.text("robot", defaultRobot()));
-  const SpaceSettings s = settingsFromArgs(a, robot);
-  const SpaceResult r = runSpace(robot, s, progress);
+  const MftSpaceSettings s = settingsFromArgs(a, robot);
+  const MftSpaceResult r = fitMftSpace(robot, s, progress.callbacks());
   const std::string output = a.text("output", defaultPolytope());
   writePolytopeFile(output, r, robot);
   progress.stage("wrote " + output);
@@ -102,7 +103,7 @@ int cmdFigure(int argc, char** argv) {
   const RobotDescription robot = loadRobotDescription(a.text("robot", defaultRobot()));
   const MftPolytope p = loadMftPolytope(a.text("polytope", defaultPolytope()), robot);
   LabelGrid joint, cart;
-  gridSpaces(robot, p.criteria, p.fit.joint_step_rad, p.fit.cartesian_step_m, progress, &joint, &cart);
+  gridMftSpaces(robot, p.criteria, p.fit.joint_step_rad, p.fit.cartesian_step_m, progress.callbacks(), &joint, &cart);
   const std::string png = a.text("png", "mft_space.png");
   const std::string data = pngDataPath(png);
   writeFigureData(data, figureInput(joint, cart, p, robot));
@@ -155,9 +156,9 @@ int cmdAll(int argc, char** argv) {
   stanceRange(a, &from, &to, &step);
   Progress progress(a.flag("quiet"));
   const RobotDescription robot = loadRobotDescription(a.text("robot", defaultRobot()));
-  const SpaceSettings s = settingsFromArgs(a, robot);
+  const MftSpaceSettings s = settingsFromArgs(a, robot);
   makeDir(dir);
-  const SpaceResult r = runSpace(robot, s, progress);
+  const MftSpaceResult r = fitMftSpace(robot, s, progress.callbacks());
   const std::string yaml = dir + "/mft_space.yaml";
   writePolytopeFile(yaml, r, robot);
   if (a.has("output")) writePolytopeFile(a.text("output", ""), r, robot);

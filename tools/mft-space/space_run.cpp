@@ -1,6 +1,5 @@
 #include "space_run.hpp"
 
-#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -10,16 +9,6 @@
 namespace mft::tools {
 
 using namespace mft::model;
-
-namespace {
-// %g, or fixed with `decimals` digits.
-std::string num(double v, int decimals = -1) {
-  char buf[40];
-  if (decimals < 0) std::snprintf(buf, sizeof buf, "%g", v);
-  else std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-}  // namespace
 
 const char* const kSpaceOptions[] = {"joint-step", "cart-step", "edges", "starts", "seed", "lti-min", "lti-max",
                                      "raci-min", "raci-max", "accel", "raci-form", "drive-k", nullptr};
@@ -39,8 +28,8 @@ MftCriteria criteriaFromArgs(const CliArgs& a, const RobotDescription& robot) {
   return c;
 }
 
-SpaceSettings settingsFromArgs(const CliArgs& a, const RobotDescription& robot) {
-  SpaceSettings s;
+MftSpaceSettings settingsFromArgs(const CliArgs& a, const RobotDescription& robot) {
+  MftSpaceSettings s;
   s.criteria = criteriaFromArgs(a, robot);
   s.joint_step_rad = a.positive("joint-step", s.joint_step_rad);
   s.cartesian_step_m = a.positive("cart-step", s.cartesian_step_m);
@@ -53,67 +42,7 @@ SpaceSettings settingsFromArgs(const CliArgs& a, const RobotDescription& robot) 
   return s;
 }
 
-void gridSpaces(const RobotDescription& robot, const MftCriteria& c, double joint_step, double cart_step,
-                Progress& progress, LabelGrid* joint, LabelGrid* cartesian) {
-  const MftLegModel leg = MftLegModel::from(robot);
-  progress.stage("gridding actuated joint space, step " + num(joint_step) + " rad");
-  *joint = gridJointSpace(leg, c, joint_step, [&](int d, int t) { progress.percent("joint grid", d, t); });
-  progress.stage("gridding Cartesian foot space, step " + num(cart_step) + " m");
-  *cartesian = gridCartesianSpace(leg, c, cart_step, [&](int d, int t) { progress.percent("Cartesian grid", d, t); });
-}
-
-SpaceResult runSpace(const RobotDescription& robot, const SpaceSettings& s, Progress& progress) {
-  SpaceResult r;
-  const auto t0 = std::chrono::steady_clock::now();
-  gridSpaces(robot, s.criteria, s.joint_step_rad, s.cartesian_step_m, progress, &r.joint, &r.cartesian);
-  const auto t1 = std::chrono::steady_clock::now();
-  r.grid_seconds = std::chrono::duration<double>(t1 - t0).count();
-
-  const MftLegModel leg = MftLegModel::from(robot);
-  PolygonFitOptions o;
-  o.edges = s.edges;
-  o.starts = s.starts;
-  o.rng_seed = s.rng_seed;
-  // Grow the polygon around the nominal stance (foot 0.40 m below the hip) when it is preferable.
-  const LegEvaluation nominal = evaluateVerticalStance(leg, s.criteria, 0.40);
-  if (nominal.preferable) {
-    o.has_seed_point = true;
-    o.seed_point = {nominal.pose.q_rear, nominal.pose.q_fore};
-  }
-  o.progress = [&](int d, int t) { progress.percent("polygon fit (random starts)", d, t); };
-  const FitCells cells = fitCellsFromGrid(r.joint);
-  progress.stage("fitting a " + std::to_string(s.edges) + "-edge polygon to " + std::to_string(cells.good.size()) +
-                 " preferable cells (" + std::to_string(cells.bad.size()) + " boundary cells)");
-  r.fit = fitConservativePolygon(cells, o);
-  if (!r.fit.ok) throw std::runtime_error("polygon fit failed: " + r.fit.error);
-  r.quality = assessPolygon(r.joint, r.fit.polygon);
-  r.fit_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-
-  MftPolytope& p = r.polytope;
-  p.leg = MftLegPolygon::fromHalfPlanes(r.fit.polygon);
-  p.criteria = s.criteria;
-  p.robot_name = robot.name;
-  p.robot_checksum = robot.checksum;
-  p.fit.joint_step_rad = s.joint_step_rad;
-  p.fit.cartesian_step_m = s.cartesian_step_m;
-  p.fit.edges = s.edges;
-  p.fit.starts = s.starts;
-  p.fit.rng_seed = s.rng_seed;
-  p.fit.area_rad2 = r.fit.area;
-  p.fit.coverage = r.quality.coverage;
-  p.fit.r_max_rad = r.quality.r_max;
-  p.fit.bad_cells_inside = r.quality.bad_inside;
-  p.fit.preferable_cells = r.joint.count(kCellPreferable);
-  p.fit.reachable_cells = r.joint.countAtLeast(kCellReachable);
-  r.has_augmented = s.edges == kMftLegEdges;
-  if (r.has_augmented) buildAugmented(p.leg, &p);
-  progress.stage("fit done: area " + num(r.fit.area, 4) + " rad^2, coverage " +
-                 num(100.0 * r.quality.coverage, 2) + " %, " + std::to_string(r.quality.bad_inside) +
-                 " bad cells inside, r " + num(r.quality.r_max, 5) + " rad");
-  return r;
-}
-
-void writePolytopeFile(const std::string& path, const SpaceResult& r, const RobotDescription& robot) {
+void writePolytopeFile(const std::string& path, const MftSpaceResult& r, const RobotDescription& robot) {
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path);
   std::string base = robot.source_file;
@@ -129,7 +58,7 @@ void writePolytopeFile(const std::string& path, const SpaceResult& r, const Robo
   if (!out) throw std::runtime_error("error while writing " + path);
 }
 
-std::string summaryJson(const SpaceResult& r) {
+std::string summaryJson(const MftSpaceResult& r) {
   const auto& q = r.quality;
   JsonWriter edges;
   edges.beginArray();
@@ -164,7 +93,7 @@ std::string summaryJson(const SpaceResult& r) {
       .endObject().str();
 }
 
-std::string summaryText(const SpaceResult& r) {
+std::string summaryText(const MftSpaceResult& r) {
   const auto& q = r.quality;
   char buf[1024];
   std::snprintf(buf, sizeof buf,

@@ -1,6 +1,7 @@
 #pragma once
 // The messages of tests/data/rawlog/schema1.rawlog, a recording made by the schema-1 recorder (before the layout
-// became generic): the version test reads that file with today's reader and compares what it gets with these.
+// became generic), and of schema2.rawlog, made by the schema-2 recorder before the rawlog's topic list was
+// generated from the registry: the version test reads both with today's reader and compares with these.
 // Plain formulas, no random numbers, so the list is the same on every machine. Integers stay below 2^53 and the
 // ConfigChange value is the text schema 1 rebuilds from its numbers: schema 1 read these back exactly.
 #include <cstdio>
@@ -78,6 +79,19 @@ inline std::vector<Message> messages() {
       out.push_back(c);
     }
   }
+  return out;
+}
+
+// schema2.rawlog: the same, then a verdict (recorded from schema 2 on) with its reason as text and a seq above
+// 2^53 (schema 2 keeps both exactly). Pushed last, it is stamped with tick 3's time and written after tick 3's
+// messages.
+inline std::vector<Message> schema2Messages() {
+  auto out = messages();
+  msg::CommandVerdict v;
+  v.seq((std::uint64_t{1} << 53) + 3), v.source(msg::COMMAND_SOURCE_SIMULATOR), v.verdict(msg::VERDICT_SCHEDULED);
+  v.accepted(true), v.tick(3), v.stamp_ns(3'000'000);
+  std::snprintf(v.reason().data(), v.reason().size(), "%s", "push armed for the next lift-off of leg 1, \"left\"");
+  out.push_back(v);
   return out;
 }
 

@@ -1,14 +1,16 @@
 // The versioned, generic layout. Recordings made before stay readable: tests/data/rawlog/schema1.rawlog was
-// written by the schema-1 recorder (hand-written channel tables, integers as doubles) from rawlog_fixture.hpp's
-// messages, and today's reader gives back exactly those messages. Schema 2 records every field of every topic
-// (CommandVerdict and its reason included) and 64-bit integers exactly.
+// written by the schema-1 recorder (hand-written channel tables, integers as doubles) and schema2.rawlog by the
+// schema-2 recorder with a hand-written topic list, both from rawlog_fixture.hpp's messages, and today's reader
+// gives back exactly those messages. Schema 2 records every field of every topic (CommandVerdict and its reason
+// included) and 64-bit integers exactly.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
 #include <cstring>
-#include <limits>
 #include <filesystem>
+#include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,7 @@ using namespace mft::rawlog;
 namespace {
 
 const std::string kSchema1File = std::string(MFT_TEST_DATA_DIR) + "/rawlog/schema1.rawlog";
+const std::string kSchema2File = std::string(MFT_TEST_DATA_DIR) + "/rawlog/schema2.rawlog";
 
 // Every message of the file, none of them incomplete or unknown.
 std::vector<Message> readAll(RawlogReader& r) {
@@ -42,12 +45,14 @@ std::vector<Message> readFile(const std::string& path) {
 }
 
 // Records `messages` in order through the recorder engine into a fresh file; its path.
-std::string record(const std::vector<Message>& messages, const std::string& name) {
+std::string record(const std::vector<Message>& messages, const std::string& name, const std::string& scenario = "") {
   const auto dir = std::filesystem::temp_directory_path() / ("mft-rawlog-versions-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   RecorderOptions opt;
   opt.output = (dir / name).string();
   opt.metadata.mode = "lockstep";
+  opt.metadata.scenario_name = scenario;
+  opt.metadata.dds_naming = "ros2";
   Recorder rec(opt);
   rec.start();
   for (const auto& m : messages) rec.push(m);
@@ -84,21 +89,65 @@ void fillEveryField(Message* m, std::uint64_t salt) {
   }
 }
 
-}  // namespace
-
-TEST(RawlogVersions, Schema1RecordingReadsBackEveryMessageExactly) {
-  RawlogReader r(kSchema1File);
-  EXPECT_EQ(r.metadata().schema_version, 1);
+// The file holds `want`, message for message, and says how it was written.
+void expectReadsBack(const std::string& file, int schema, const std::string& scenario, const std::vector<Message>& want) {
+  RawlogReader r(file);
+  EXPECT_EQ(r.metadata().schema_version, schema);
   EXPECT_EQ(r.metadata().dds_naming, "ros2");
-  EXPECT_EQ(r.metadata().scenario_name, "schema1-fixture");
+  EXPECT_EQ(r.metadata().scenario_name, scenario);
   const auto got = readAll(r);
   EXPECT_EQ(r.end(), RawlogReader::End::Clean);
-  const auto want = fixture::messages();
   ASSERT_EQ(got.size(), want.size());
   for (std::size_t i = 0; i < want.size(); ++i) {
     ASSERT_EQ(got[i].index(), want[i].index()) << "message " << i;
     EXPECT_TRUE(got[i] == want[i]) << "message " << i << " (" << topicName(topicOf(want[i])) << ") differs";
   }
+}
+
+}  // namespace
+
+TEST(RawlogVersions, Schema1RecordingReadsBackEveryMessageExactly) {
+  expectReadsBack(kSchema1File, 1, "schema1-fixture", fixture::messages());
+}
+
+TEST(RawlogVersions, Schema2RecordingReadsBackEveryMessageExactly) {
+  expectReadsBack(kSchema2File, 2, "schema2-fixture", fixture::schema2Messages());
+  RawlogReader r(kSchema2File);
+  const auto got = readAll(r);
+  ASSERT_FALSE(got.empty());
+  EXPECT_STREQ(std::get<msg::CommandVerdict>(got.back()).reason().data(),
+               "push armed for the next lift-off of leg 1, \"left\"");
+}
+
+// A topic's rawlog id (idl/topics.yaml, rawlog_id; the Topic value and Message index) is the order the writer
+// puts the messages of one timestamp in. The fixtures hold every recorded topic at timestamps shared with topics
+// of other ids, in the order of the ids they were written with: a renumbered topic shows as a pair out of order.
+TEST(RawlogVersions, TopicIdsAreThoseTheRecordingsWereWrittenWith) {
+  std::set<std::size_t> seen;
+  for (const auto& file : {kSchema1File, kSchema2File}) {
+    RawlogReader r(file);
+    MessageAssembler a(r.metadata().time_base_unix_ns);
+    mrpt::obs::CObservation::Ptr obs;
+    Message m;
+    std::int64_t t = 0, prev_t = -1;
+    std::size_t prev_id = 0;
+    while (r.next(&obs)) {
+      if (!a.add(*obs, &m, &t)) continue;
+      if (t == prev_t) {
+        EXPECT_LT(prev_id, m.index()) << file << ": " << topicName(topicOf(m)) << " after topic id " << prev_id;
+      }
+      prev_t = t, prev_id = m.index();
+      seen.insert(m.index());
+    }
+  }
+  EXPECT_EQ(seen.size(), 10u);  // the topics recorded when the ids were made explicit, every one checked
+}
+
+// Writes tests/data/rawlog/schema2.rawlog (run once with --gtest_also_run_disabled_tests; the file is kept as
+// written, the guard for every later change of the writer).
+TEST(RawlogVersions, DISABLED_WriteSchema2Fixture) {
+  const std::string tmp = record(fixture::schema2Messages(), "schema2.rawlog", "schema2-fixture");
+  std::filesystem::copy_file(tmp, kSchema2File, std::filesystem::copy_options::overwrite_existing);
 }
 
 // Item: event seq values above 2^53 were recorded as doubles, and the three requests of one mft-cmd call came back

@@ -3,7 +3,9 @@
 idl/mft_msgs.idl; docs/architecture.md#the-topic-registry). Run by CMake at build time into the build tree:
 
   gen_topics.py cxx DIR        DIR/mft_topic_table.hpp: the rows as constexpr data and X-macros (no DDS type);
-                               DIR/mft_topics.hpp: with Fast DDS's types, dispatch by name and field visitors
+                               DIR/mft_topics.hpp: with Fast DDS's types, dispatch by name and field visitors;
+                               DIR/mft_msgs_fields.h: each message's fields with their addresses (rawlog layout);
+                               DIR/mft_rawlog_topics.hpp: the recorded topics by rawlog id (Topic, Message)
   gen_topics.py cyclone DIR    DIR/mft_cyclone_topics.hpp: the same over Cyclone DDS's C types (mft-cyclone)
   gen_topics.py ros2 DIR       the ROS 2 message package's generated files (msg/*.msg, CMakeLists.txt)
   gen_topics.py docs           the topic table of docs/architecture.md (Markdown)
@@ -55,7 +57,7 @@ def ros2_msg(r, t):
             consts.append(f"uint8 {name}={value}" + (f"  # {comment}" if comment else ""))
     fields = []
     for f in s.fields:
-        ros = reg.IDL_TYPES[f.idl_type][1] + (f"[{f.count}]" if f.count else "")
+        ros = reg.IDL_TYPES[f.idl_type].ros2 + (f"[{f.count}]" if f.count else "")
         fields.append(f"{ros} {f.name}" + (f"  # {f.comment}" if f.comment else ""))
     blocks = [head, consts, fields] if consts else [head, fields]
     return "\n\n".join("\n".join(b) for b in blocks) + "\n"
@@ -144,6 +146,8 @@ def main(argv):
     if a.what == "cxx":
         write_if_changed(Path(a.dir) / "mft_topic_table.hpp", gen_topics_cxx.table_header(r))
         write_if_changed(Path(a.dir) / "mft_topics.hpp", gen_topics_cxx.fastdds_header(r))
+        write_if_changed(Path(a.dir) / "mft_msgs_fields.h", gen_topics_cxx.fields_header(r))
+        write_if_changed(Path(a.dir) / "mft_rawlog_topics.hpp", gen_topics_cxx.rawlog_header(r))
     elif a.what == "cyclone":
         write_if_changed(Path(a.dir) / "mft_cyclone_topics.hpp", gen_topics_cxx.cyclone_header(r))
     elif a.what == "ros2":

@@ -18,11 +18,34 @@ QOS_PROFILES = {"chain": (("lockstep_writer", "control_writer"), ("lockstep_read
                 "event": (("command_writer", "verdict_writer", "event_writer"), ("event_reader",)),
                 "progress": (("lockstep_writer",), ("lockstep_reader",))}
 QOS_CLASSES = tuple(QOS_PROFILES)
-ROW_KEYS = {"type", "wire", "qos", "chain", "record", "writers", "readers", "faults", "bad_values", "content"}
-# IDL field types the messages use -> (C++ scalar, ROS 2 .msg type)
-IDL_TYPES = {"unsigned long long": ("std::uint64_t", "uint64"), "double": ("double", "float64"),
-             "boolean": ("bool", "bool"), "octet": ("std::uint8_t", "uint8"), "short": ("std::int16_t", "int16"),
-             "long": ("std::int32_t", "int32"), "char": ("char", "uint8")}
+ROW_KEYS = {"type", "wire", "qos", "chain", "record", "rawlog_id", "writers", "readers", "faults", "bad_values",
+            "content"}
+OPTIONAL_KEYS = {"bad_values", "rawlog_id"}
+
+
+@dataclass(frozen=True)
+class IdlType:
+    cxx: str   # the C++ scalar
+    ros2: str  # the ROS 2 .msg type
+    kind: str  # its msg::fields::Kind (mft_msgs_fields.h)
+    short: str  # its msg::FieldKind (mft_topics.hpp)
+
+
+# The IDL's scalar types a message may use (each field: a scalar or a fixed-size array of one).
+IDL_TYPES = {
+    "unsigned long long": IdlType("std::uint64_t", "uint64", "UInt64", "U64"),
+    "double": IdlType("double", "float64", "Double", "F64"),
+    "boolean": IdlType("bool", "bool", "Bool", "Bool"),
+    "octet": IdlType("std::uint8_t", "uint8", "Octet", "U8"),
+    "short": IdlType("std::int16_t", "int16", "Int16", "I16"),
+    "long": IdlType("std::int32_t", "int32", "Int32", "I32"),
+    "char": IdlType("char", "uint8", "Char", "Char"),
+    "unsigned short": IdlType("std::uint16_t", "uint16", "UInt16", "U16"),
+    "unsigned long": IdlType("std::uint32_t", "uint32", "UInt32", "U32"),
+    "long long": IdlType("std::int64_t", "int64", "Int64", "I64"),
+    "float": IdlType("float", "float32", "Float", "F32"),
+}
+_FIELD = re.compile(r"(%s) (\w+) ?(?:\[ ?(\d+) ?\])? ?;" % "|".join(sorted(IDL_TYPES, key=len, reverse=True)))
 
 
 class RegistryError(Exception):
@@ -56,10 +79,16 @@ class Topic:
     faults: bool
     content: str
     bad_values: dict = field(default_factory=dict)
+    rawlog_id: "int | None" = None  # recorded topics: the Topic value of the rawlog, never changed or reused
     struct: Struct = None
 
     def has_field(self, name):
         return any(f.name == name for f in self.struct.fields)
+
+    def ticked(self):
+        """In the rawlog: a stream of ticks stamped by the simulator's clock (tick, stamp_ns), not an event (seq,
+        stamped on arrival)."""
+        return self.qos != "event"
 
     def subscribers(self):
         """The identities allowed to read it: its readers, and the recorder when it is recorded."""
@@ -101,9 +130,10 @@ def parse_idl(text, source="idl"):
             continue
         if not code:
             continue
-        m = re.fullmatch(r"(unsigned long long|double|boolean|octet|short|long|char)\s+(\w+)(?:\[(\d+)\])?;", code)
+        m = _FIELD.fullmatch(" ".join(code.split()))
         if not m:
-            raise RegistryError(f"{source}: field '{code}' of {current.name} has a type the registry does not know")
+            raise RegistryError(f"{source}: field '{code}' of {current.name} has a type the registry does not know "
+                                f"(one of: {', '.join(IDL_TYPES)}; arrays of fixed size)")
         current.fields.append(Field(m.group(2), m.group(1), int(m.group(3)) if m.group(3) else None, comment))
     return consts, structs
 
@@ -112,7 +142,7 @@ def _row(entry, structs, where):
     unknown = set(entry) - ROW_KEYS
     if unknown:
         raise RegistryError(f"{where}: unknown keys {sorted(unknown)} (known: {sorted(ROW_KEYS)})")
-    missing = ROW_KEYS - {"bad_values"} - set(entry)
+    missing = ROW_KEYS - OPTIONAL_KEYS - set(entry)
     if missing:
         raise RegistryError(f"{where}: missing {sorted(missing)}")
     t = Topic(**{k: entry[k] for k in ROW_KEYS if k in entry})
@@ -132,7 +162,30 @@ def _row(entry, structs, where):
             raise RegistryError(f"{where}: bad_values names {name}, not a field of {t.type}")
     if t.chain and t.qos != "chain":
         raise RegistryError(f"{where}: a topic on the chain channel needs qos chain")
+    _check_recording(t, where)
     return t
+
+
+def _check_recording(t, where):
+    """A recorded row has its rawlog id, and the fields the rawlog stamps it by."""
+    if t.record != (t.rawlog_id is not None):
+        raise RegistryError(f"{where}: rawlog_id is given exactly when record is true (a new recorded topic takes "
+                            "the next free id)")
+    if t.rawlog_id is not None and (not isinstance(t.rawlog_id, int) or isinstance(t.rawlog_id, bool)
+                                    or t.rawlog_id < 0):
+        raise RegistryError(f"{where}: rawlog_id {t.rawlog_id!r} is not an integer >= 0")
+    need = ("tick", "stamp_ns") if t.ticked() else ("seq",)
+    if t.record and not all(t.has_field(f) for f in need):
+        raise RegistryError(f"{where}: a recorded {'stream' if t.ticked() else 'event'} topic needs the fields "
+                            f"{', '.join(need)}")
+
+
+def _check_rawlog_ids(rows):
+    """The rawlog ids are 0..n-1, each once: a message's id is its index in the rawlog's variant."""
+    ids = sorted(t.rawlog_id for t in rows if t.record)
+    if ids != list(range(len(ids))):
+        raise RegistryError(f"the rawlog ids of the recorded topics are {ids}, not 0..{len(ids) - 1} each once "
+                            "(a new recorded topic takes the one after the highest; never renumber one)")
 
 
 @dataclass
@@ -146,6 +199,10 @@ class Registry:
             if t.type == type_name:
                 return t
         raise RegistryError(f"unknown topic {type_name} (one of {', '.join(t.type for t in self.topics)})")
+
+    def recorded(self):
+        """The recorded topics by rawlog id."""
+        return sorted((t for t in self.topics if t.record), key=lambda t: t.rawlog_id)
 
     def names(self, **where):
         """The topic types, in registry order, whose attributes equal `where` (e.g. faults=True)."""
@@ -175,6 +232,7 @@ def load(idl_paths=(IDL,), registry_paths=(REGISTRY,)):
     names = [t.type for t in rows]
     if len(set(names)) != len(names):
         raise RegistryError("a topic is listed twice: " + ", ".join(sorted({n for n in names if names.count(n) > 1})))
+    _check_rawlog_ids(rows)
     lonely = sorted(set(structs) - set(names))
     if lonely:
         raise RegistryError(f"messages without a row in the topic table: {', '.join(lonely)}")

@@ -73,28 +73,11 @@ void setStamp(Message* m, std::uint64_t stamp_ns) {
       *m);
 }
 
-template <std::size_t... I>
-std::array<const char*, kNumTopics> makeNames(std::index_sequence<I...>) {
-  return {msg::fields::Of<std::variant_alternative_t<I, Message>>::name...};
-}
-const std::array<const char*, kNumTopics> kTopicNames = makeNames(std::make_index_sequence<kNumTopics>());
-
 }  // namespace
 
 Message emptyMessage(Topic t) {
   static const auto empty = makeEmpty(std::make_index_sequence<kNumTopics>());
   return empty[static_cast<std::size_t>(t)];
-}
-
-const char* topicName(Topic t) { return kTopicNames[static_cast<std::size_t>(t)]; }
-
-bool parseTopic(const std::string& name, Topic* out) {
-  for (std::size_t i = 0; i < kNumTopics; ++i)
-    if (name == kTopicNames[i]) {
-      *out = static_cast<Topic>(i);
-      return true;
-    }
-  return false;
 }
 
 std::uint64_t tickOf(const Message& m) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "idl/msg_types.hpp"
+#include "mft_rawlog_topics.hpp"
 
 namespace mft::rawlog {
 
@@ -27,29 +28,9 @@ constexpr int kSchemaVersion = 2;        // written
 constexpr int kOldestSchemaVersion = 1;  // read: 1 (before exact integers and text) and 2
 constexpr const char* kFormatName = "mft-rawlog";
 
-// The recorded topics, in the order messages of one tick are written (the simulator's outputs first).
-enum class Topic : std::uint8_t {
-  GroundTruth = 0,
-  SensorData,
-  RobotState,
-  Reference,
-  JointCommand,
-  WbcDiagnostics,
-  OperatorCommand,
-  Disturbance,
-  ConfigChange,    // live tuning (docs/live-tuning.md): requests and the changes the services applied
-  CommandVerdict,  // the stack's answer to each command, push and live change (with its reason as text)
-};
-constexpr std::size_t kNumTopics = 10;
-const char* topicName(Topic t);
-bool parseTopic(const std::string& name, Topic* out);
-// Topics whose messages carry tick and stamp_ns (the others are events, stamped on arrival).
-constexpr bool hasTick(Topic t) { return t <= Topic::WbcDiagnostics; }
-
-// Variant index == Topic value.
-using Message = std::variant<msg::GroundTruth, msg::SensorData, msg::RobotState, msg::Reference, msg::JointCommand,
-                             msg::WbcDiagnostics, msg::OperatorCommand, msg::Disturbance, msg::ConfigChange,
-                             msg::CommandVerdict>;
+// The recorded topics (Topic, kNumTopics, the Message variant, hasTick, topicName, parseTopic) are generated
+// from the topic registry: idl/topics.yaml's rows with record: true, numbered by their rawlog_id
+// (mft_rawlog_topics.hpp, idl/gen_topics.py). The messages of one timestamp are written in that order.
 inline Topic topicOf(const Message& m) { return static_cast<Topic>(m.index()); }
 Message emptyMessage(Topic t);  // a default-constructed message of the topic
 // tick (or seq for events) and stamp_ns of a message (0 for events).

@@ -1,5 +1,5 @@
 #pragma once
-// The generic rawlog layout: how a message's fields (the tables idl/gen_msg_fields.py generates from the IDL)
+// The generic rawlog layout: how a message's fields (the tables idl/gen_topics.py generates from the IDL)
 // become the channels of its labels, and the one writer and one reader of a sample through it. Built once at
 // start; per sample the writer and reader only index into these tables (nothing is allocated).
 //   AIN_double: one channel per element of each numeric field (or a derived value, e.g. a key's index).

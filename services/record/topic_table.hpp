@@ -4,8 +4,8 @@
 // In a lockstep stack on the chain channel (--chain-shm), the 1 kHz topics come from the channel's rings instead
 // (services/runtime/chain_channel.hpp), drained by one thread every millisecond: the writers then send nothing
 // over DDS for the recorder.
-// The topics are the registry's rows with `record: true` (idl/topics.yaml); a row the rawlog cannot hold yet
-// (no alternative of rawlog::Message) is a compile error, not a silent gap.
+// The topics are the registry's rows with `record: true` (idl/topics.yaml), the same rows the rawlog's Message
+// variant is generated from (mft_rawlog_topics.hpp).
 #include <algorithm>
 #include <atomic>
 #include <chrono>

@@ -27,6 +27,12 @@ PERMISSIONS_BEFORE = {
     "cmd": ("OperatorCommand Disturbance ConfigChange", "CommandVerdict"),
 }
 
+# The rawlog ids of the topics recorded when the ids were written into the registry: the order the recordings made
+# until then hold (test_rawlog_versions reads it back from tests/data/rawlog). An id never changes; a new recorded
+# topic takes the next.
+RAWLOG_IDS = {"GroundTruth": 0, "SensorData": 1, "RobotState": 2, "Reference": 3, "JointCommand": 4,
+              "WbcDiagnostics": 5, "OperatorCommand": 6, "Disturbance": 7, "ConfigChange": 8, "CommandVerdict": 9}
+
 
 def gen(*args):
     return subprocess.run([sys.executable, str(GEN), *args], capture_output=True, text=True, timeout=60)
@@ -54,6 +60,14 @@ class TopicRegistry(unittest.TestCase):
         lines = gen("security").stdout.splitlines()
         self.assertIn("cmd pub OperatorCommand Disturbance ConfigChange", lines)
 
+    def test_rawlog_ids_never_change_and_a_new_topic_takes_the_next(self):
+        reg = topics.load()
+        got = {t.type: t.rawlog_id for t in reg.recorded()}
+        self.assertEqual({k: got.get(k) for k in RAWLOG_IDS}, RAWLOG_IDS)
+        self.assertEqual(sorted(got.values()), list(range(len(got))))
+        self.assertEqual([t.type for t in reg.recorded()][:len(RAWLOG_IDS)], list(RAWLOG_IDS))
+        self.assertEqual({t.type for t in reg.topics if not t.record}, {"RecorderProgress"})
+
     def test_every_qos_class_names_profiles_of_dds_profiles_xml(self):
         root = ET.parse(REPO / "config" / "dds_profiles.xml").getroot()
         names = {e.get("profile_name") for e in root.iter() if e.get("profile_name")}
@@ -67,7 +81,11 @@ class TopicRegistry(unittest.TestCase):
         cases = {"wire: rt/mft/sensor_data": ("wire: rt/mft/sensors", "is not ROS 2's name"),
                  "writers: [sim]": ("writers: [simulator]", "not a security identity"),
                  "qos: progress": ("qos: fast", "is not one of"),
-                 "bad_values: {mode: 99}": ("bad_values: {mood: 99}", "not a field of OperatorCommand")}
+                 "bad_values: {mode: 99}": ("bad_values: {mood: 99}", "not a field of OperatorCommand"),
+                 "    rawlog_id: 9\n": ("", "rawlog_id is given exactly when record is true"),
+                 "    rawlog_id: 8\n": ("    rawlog_id: 9\n", "not 0..9 each once"),
+                 "record: false\n": ("record: false\n    rawlog_id: 10\n", "rawlog_id is given exactly when"),
+                 "qos: event": ("qos: chain", "a recorded stream topic needs the fields tick, stamp_ns")}
         with tempfile.TemporaryDirectory() as d:
             for old, (new, why) in cases.items():
                 p = Path(d) / "topics.yaml"

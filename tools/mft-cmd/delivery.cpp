@@ -144,11 +144,15 @@ void Reach::writeJson(config::JsonWriter& w) const {
 // announcement creates). Fast DDS may still report the match before the participant, on another thread, so the
 // loop also waits until every matched reader's participant is known. From then on the list of services that
 // must have the sample is complete, including one not discovered yet (the recorder runs niced and may answer
-// discovery last), and that one is waited for by name, up to the deadline: a condition, not a sleep. A stack
+// discovery last), and that one is waited for by name, up to the deadline: a condition, not a sleep. The recorder
+// announces nothing itself, so the list counts as complete only once the answering service (started by the
+// supervisor like every service) has been discovered: with only the recorder heard, the planner's or the WBC's
+// acknowledgement would otherwise go unchecked. A stack
 // started by hand, without the supervisor's --stack-services, announces nothing: then only the participants
 // discovered before every one of them acknowledged are waited for.
 std::vector<Reach> awaitDelivery(const services::DdsParticipant& participant, std::string_view topic,
-                                 const std::vector<AckSource*>& writers, Clock::time_point deadline) {
+                                 const std::vector<AckSource*>& writers, const std::vector<std::string>& answerers,
+                                 Clock::time_point deadline) {
   const int row = msg::topicIndex(topic);
   const msg::TopicInfo& info = msg::kTopics[static_cast<std::size_t>(std::max(row, 0))];
   std::vector<Follow> follows(writers.size());
@@ -161,6 +165,8 @@ std::vector<Reach> awaitDelivery(const services::DdsParticipant& participant, st
     seen = participant.discoveredParticipants();
     required = requiredServices(info, seen);
     bool done = row >= 0 && allIdentified(follows, seen);
+    for (const auto& service : answerers)
+      done = done && std::any_of(seen.begin(), seen.end(), [&](const auto& p) { return p.present && p.name == service; });
     for (const auto& f : follows)
       for (const auto& service : required) done = done && whyNot(service, f, seen).empty();
     if (done || Clock::now() >= deadline) break;

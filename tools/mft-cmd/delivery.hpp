@@ -61,8 +61,9 @@ struct Reach {
 };
 
 // Waits until every service that reads `topic` has acknowledged the sample on each of `writers` (written already),
-// or until `deadline`; one Reach per writer.
+// and the `answerers` (the services that answer it) have been discovered, or until `deadline`; one Reach per writer.
 std::vector<Reach> awaitDelivery(const services::DdsParticipant& participant, std::string_view topic,
-                                 const std::vector<AckSource*>& writers, std::chrono::steady_clock::time_point deadline);
+                                 const std::vector<AckSource*>& writers, const std::vector<std::string>& answerers,
+                                 std::chrono::steady_clock::time_point deadline);
 
 }  // namespace mft::cmd

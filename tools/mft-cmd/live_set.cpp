@@ -162,7 +162,11 @@ class LiveSet {
     std::vector<std::unique_ptr<WriterAcks<Writer>>> acks;
     std::vector<AckSource*> sources;
     for (const auto& w : writers) sources.push_back(acks.emplace_back(std::make_unique<WriterAcks<Writer>>(*w)).get());
-    const std::vector<Reach> reaches = awaitDelivery(participant, "ConfigChange", sources, written_at_.back() + x_.timeout);
+    std::vector<std::string> answerers;
+    for (const auto& c : changes_)
+      if (std::find(answerers.begin(), answerers.end(), c.answerer) == answerers.end()) answerers.push_back(c.answerer);
+    const std::vector<Reach> reaches =
+        awaitDelivery(participant, "ConfigChange", sources, answerers, written_at_.back() + x_.timeout);
     acknowledged_ = true;
     for (std::size_t i = 0; i < changes_.size(); ++i) {
       changes_[i].reach = reaches[i];

@@ -161,7 +161,7 @@ class CommandSend {
   template <class Writer>
   Reach deliver(const services::DdsParticipant& participant, Writer& writer) {
     WriterAcks<Writer> acks(writer);
-    return awaitDelivery(participant, out_.topic, {&acks}, written_at_ + x_.timeout).front();
+    return awaitDelivery(participant, out_.topic, {&acks}, {out_.answerer}, written_at_ + x_.timeout).front();
   }
 
   // The verdicts: rejected, or scheduled then applied.

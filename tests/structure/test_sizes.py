@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The thin floors keep their limits (scripts/check-sizes.py): no function over 80 lines in tools/, services/,
-python/ and chain/, no main over 150 lines. First checks the scanner on a scratch file of known lengths."""
+python/ and chain/, no main over 150 lines, tools/ at most 7,000 lines. First checks the scanner on a scratch file
+of known lengths."""
 import importlib.util
 import sys
 import tempfile
@@ -49,7 +50,19 @@ class Sizes(unittest.TestCase):
         v = r["violations"]
         lines = [f"function {f['length']} lines: {f['file']}:{f['line']} {f['name']}" for f in v["functions"]]
         lines += [f"main {n} lines: {p}" for p, n in v["mains"].items()]
+        if v["tools_lines"]:
+            lines.append(f"tools/ {v['tools_lines']} lines, over {r['tools_limit']}: move library code to its floor")
         self.assertEqual(lines, [], "over the limits:\n  " + "\n  ".join(lines))
+
+    def test_tools_total_is_limited(self):
+        """tools/ is counted over its C++ and Python files only, and one line over the limit is a violation."""
+        def files(n):
+            return [{"path": "tools/a/x.cpp", "lines": n, "main": False, "functions": []},
+                    {"path": "python/p/y.py", "lines": 50000, "main": False, "functions": []}]
+        limit = check_sizes.TOOLS_LIMIT
+        self.assertIsNone(check_sizes.report(files(limit))["violations"]["tools_lines"])
+        over = check_sizes.report(files(limit + 1))
+        self.assertEqual((over["tools_code_lines"], over["violations"]["tools_lines"]), (limit + 1, limit + 1))
 
     def test_a_long_function_and_a_long_main_are_named(self):
         """The check can fail: a scratch tree with an 81-line function in a 151-line main is two violations."""

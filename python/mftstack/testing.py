@@ -227,10 +227,15 @@ class StackUpTestCase(unittest.TestCase):
         cls.run_dir = cls.stacks.path / "run" if cls.stack_run_dir else None
         cls.status, cls.up_error = None, None
         try:
-            cls.status = cls.stacks.up(cls.stack_scenario, cls.stack_domain, *cls.stack_args,
+            cls.status = cls.stacks.up(cls.stack_scenario, cls.stack_domain, *cls.stack_up_args(),
                                        *(["--run-dir", cls.run_dir] if cls.run_dir else []), timeout=180)
         except AssertionError as e:
             cls.up_error = str(e)
+
+    @classmethod
+    def stack_up_args(cls):
+        """The options of `up` after scenario and domain (stack_args; a class may add paths under cls.stacks)."""
+        return cls.stack_args
 
     @classmethod
     def tearDownClass(cls):

@@ -17,7 +17,7 @@ import unittest
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
-from mftstack.testing import BIN, StackRunner, mft_cmd  # noqa: E402
+from mftstack.testing import BIN, StackUpTestCase, mft_cmd  # noqa: E402
 
 DOMAIN = 88
 RECORDER = "mft-record"
@@ -71,29 +71,24 @@ def export_seqs(rawlog, out):
     return seqs
 
 
-class EveryReaderGetsTheRequest(unittest.TestCase):
+class EveryReaderGetsTheRequest(StackUpTestCase):
     """The tests run in name order against one stack; the last one stops it and reads the recording."""
+
+    tmp_prefix = "mft-cmd-delivery-"
+    stack_scenario = "stand.yaml"
+    stack_domain = DOMAIN
+    stack_run_dir = True
+
+    @classmethod
+    def stack_up_args(cls):
+        cls.rawlog = cls.stacks.path / "delivery.rawlog"
+        return ("--mode", "realtime", "--record", cls.rawlog)
 
     @classmethod
     def setUpClass(cls):
-        cls.stacks = StackRunner(prefix="mft-cmd-delivery-")
-        cls.rawlog = cls.stacks.path / "delivery.rawlog"
         cls.delivered = {label: [] for label in TOPIC_OF.values()}  # seqs mft-cmd reported delivered to the recorder
         cls.lost = {label: [] for label in TOPIC_OF.values()}       # seqs it reported missing from the recorder
-        cls.status, cls.up_error = None, None
-        try:
-            cls.status = cls.stacks.up("stand.yaml", DOMAIN, "--mode", "realtime", "--record", cls.rawlog,
-                                       "--run-dir", cls.stacks.path / "run", timeout=180)
-        except AssertionError as e:
-            cls.up_error = str(e)
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.stacks.close()
-
-    def setUp(self):
-        if self.up_error:
-            self.fail(self.up_error)
+        super().setUpClass()
 
     def note(self, argv, seqs, result):
         """Files each request's seq under what mft-cmd said of the recorder."""

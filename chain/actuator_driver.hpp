@@ -1,6 +1,6 @@
 #pragma once
 // The hardware boundary: what a robot's actuator driver does with the joint commands it receives, and what
-// mft-sim does as one (docs/faults.md, docs/architecture.md#clock-and-loop-modes). A real robot's bridge can
+// mft-sim does as one (docs/results/faults.md, docs/reference/architecture.md#clock-and-loop-modes). A real robot's bridge can
 // reuse it as it is:
 //  - a command that is not finite, beyond the actuators' peak torque or of an unknown mode is refused: it never
 //    reaches an actuator and counts as missing (input_guard.hpp);

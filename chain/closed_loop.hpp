@@ -29,7 +29,7 @@ namespace mft::closedloop {
 // Every configuration a run needs, loaded from one config folder (the same files the services read).
 struct Configs {
   std::string config_dir;
-  std::vector<std::string> profiles;  // config/profiles/ applied, in order (docs/profiles.md)
+  std::vector<std::string> profiles;  // config/profiles/ applied, in order (docs/guide/profiles.md)
   model::RobotDescription robot;
   sim::SimOptions sim;
   estimator::EstimatorConfig estimator;

@@ -1,5 +1,5 @@
 #pragma once
-// The simulator's actuator-driver watchdog in realtime mode (docs/architecture.md#clock-and-loop-modes): when a published tick
+// The simulator's actuator-driver watchdog in realtime mode (docs/reference/architecture.md#clock-and-loop-modes): when a published tick
 // has waited longer than the timeout for its joint command, the actuators go into damping until commands
 // resume. The wait is measured from the tick's publication, not from the last command's arrival: a simulator
 // that wakes up late and catches up by stepping back to back must not book its own lateness as a controller

@@ -1,5 +1,5 @@
 #pragma once
-// Checks of what arrives from the network before it reaches the actuators or the robot (docs/faults.md):
+// Checks of what arrives from the network before it reaches the actuators or the robot (docs/results/faults.md):
 // the simulator's actuator driver refuses a joint command that is not finite, beyond the actuators' peak
 // torque or of an unknown mode (a refused command counts as a missing one, so the command watchdog damps),
 // and a disturbance that is not finite, beyond the largest push an operator may send, or malformed.

@@ -1,4 +1,4 @@
-# What `cmake --install` puts under a prefix and what `cpack -G DEB` packs (docs/library.md):
+# What `cmake --install` puts under a prefix and what `cpack -G DEB` packs (docs/guide/library.md):
 #   lib/                       the algorithm libraries (static), exported as mft::common, mft::model, mft::qp,
 #                              mft::wbc, mft::planner, mft::estimator, mft::sim
 #   lib/cmake/mft_wbc/         mft_wbcConfig.cmake (find_package(mft_wbc)), its version file and the targets
@@ -6,7 +6,7 @@
 #   bin/                       the services, the tools (mft_add_executable) and mft-supervisor
 #   share/mft_wbc/config       the configuration; share/mft_wbc/scripts the tools' plotting scripts;
 #                              share/mft_wbc/python the supervisor's package (mftstack)
-#   share/doc/mft-wbc/         README, docs/library.md and the example project
+#   share/doc/mft-wbc/         README, docs/guide/library.md and the example project
 # No DDS or MRPT library is installed for linking: the stack's middleware is not part of the library interface.
 include(CMakePackageConfigHelpers)
 
@@ -69,11 +69,11 @@ install(FILES ${PROJECT_SOURCE_DIR}/tools/mft-export/mft_video_panel.py  # impor
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/python/mftstack DESTINATION ${MFT_INSTALL_DATADIR}/python COMPONENT runtime
         PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
 install(PROGRAMS ${PROJECT_SOURCE_DIR}/services/mft-supervisor DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs/library.md
+install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/docs/guide/library.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples COMPONENT development)
 
-# The Debian package: `cpack -G DEB` in the build folder (docs/library.md#debian-package).
+# The Debian package: `cpack -G DEB` in the build folder (docs/guide/library.md#debian-package).
 set(CPACK_PACKAGE_NAME mft-wbc)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
 set(CPACK_PACKAGE_VENDOR "mft-wbc")

@@ -17,7 +17,7 @@ function(mft_add_library name)
   add_library(${name} ${A_SOURCES})
   mft_target_settings(${name})
   # Sources include "model/...", "wbc/qp/..." from the repository root; an install keeps that layout under
-  # <prefix>/include/mft (docs/library.md).
+  # <prefix>/include/mft (docs/guide/library.md).
   target_include_directories(${name} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
                                             $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/mft>)
   target_link_libraries(${name} PUBLIC ${A_PUBLIC_DEPS} PRIVATE ${A_PRIVATE_DEPS})

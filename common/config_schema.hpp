@@ -1,7 +1,7 @@
 #pragma once
 // The one table of every numeric configuration key: its physical range and unit. Every strict loader
 // (strict_yaml.hpp) checks the numbers it read against it when the file is finished, so the config check,
-// live tuning (which runs the file's loader) and the generated reference (docs/config-reference.md) agree.
+// live tuning (which runs the file's loader) and the generated reference (docs/reference/config-reference.md) agree.
 // Ranges are what is physically sane for a legged robot of this kind, never tuned values.
 #include <string>
 #include <vector>
@@ -22,7 +22,7 @@ const std::vector<KeyRange>& configSchema();
 const KeyRange* findKeyRange(const std::string& stem, const std::string& key);
 // "must lie in [lo, hi] unit (got v)" if v is outside the entry's range, else "".
 std::string rangeViolation(const KeyRange& range, double v);
-// The reference table of docs/config-reference.md (Markdown), generated from configSchema().
+// The reference table of docs/reference/config-reference.md (Markdown), generated from configSchema().
 std::string schemaMarkdown();
 
 }  // namespace mft::config

@@ -2,7 +2,7 @@
 // Where a tool finds the project's data files (the configuration folder, the plotting scripts). A build folder's
 // executables use the source tree's paths compiled into them; an installed executable (cmake --install, the
 // .deb) in <prefix>/bin uses <prefix>/share/mft_wbc, so an install works without the source tree and without
-// --config-dir. One rule for every tool (docs/library.md#layout-of-an-install).
+// --config-dir. One rule for every tool (docs/guide/library.md#layout-of-an-install).
 #include <string>
 
 namespace mft::config {

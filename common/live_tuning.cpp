@@ -20,7 +20,7 @@ std::vector<std::string> splitKey(const std::string& dotted) { return splitOn(do
 
 const std::vector<TunableKey>& tunableKeys() {
   // Append only (the index is recorded). The WBC reads every one of these from its parameters at each tick,
-  // the planner its swing, foot placement and height-rate parameters at each update (docs/live-tuning.md).
+  // the planner its swing, foot placement and height-rate parameters at each update (docs/guide/live-tuning.md).
   static const std::vector<TunableKey> keys = {
       {"wbc", "weights.base_z", 1},
       {"wbc", "weights.base_pitch", 1},

@@ -1,5 +1,5 @@
 #pragma once
-// Live tuning (docs/live-tuning.md): the configuration keys a running stack may change (`mft-cmd --set`), and
+// Live tuning (docs/guide/live-tuning.md): the configuration keys a running stack may change (`mft-cmd --set`), and
 // the one way a change is judged: the key is set in a copy of the file's YAML and the copy goes through the
 // file's own strict loader, so a refused change carries the loader's message.
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// Named configuration profiles (docs/profiles.md): config/profiles/<name>.yaml overlays whose top-level keys
+// Named configuration profiles (docs/guide/profiles.md): config/profiles/<name>.yaml overlays whose top-level keys
 // are the stems of the configuration files (robot, sim, estimator, planner, wbc) and whose leaves replace
 // keys of those files. Strict: an overlay key that the base file does not have, or a mapping where the base
 // has a value (or the reverse), is a ConfigError naming the profile file and the key. Profiles compose in

@@ -1,5 +1,5 @@
 #pragma once
-// Kinematics of one planar five-bar leg (docs/five-bar-theory.md#leg-geometry-and-conventions), in the leg frame = base frame:
+// Kinematics of one planar five-bar leg (docs/reference/five-bar-theory.md#leg-geometry-and-conventions), in the leg frame = base frame:
 // x forward, z up, hips at (-s/2, 0) (rear) and (+s/2, 0) (fore). Angles are CCW (about -y).
 // Hip angle q_i is measured from the downward axis: knee B_i = A_i + l1 (sin q_i, -cos q_i).
 // Shank angle alpha_i likewise: foot C = B_i + l2 (sin alpha_i, -cos alpha_i). Knee = alpha_i - q_i.

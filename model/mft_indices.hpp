@@ -1,5 +1,5 @@
 #pragma once
-// Local transmission index (LTI) of one planar five-bar leg: paper eq. 3-4, closed forms of docs/five-bar-theory.md#transmission-indices-lti.
+// Local transmission index (LTI) of one planar five-bar leg: paper eq. 3-4, closed forms of docs/reference/five-bar-theory.md#transmission-indices-lti.
 // ITI of chain i = |sin(knee_i)| = |e_i x u_i|, OTI = |u_r x u_f| (both chains), LTI = min of all three.
 // Every value is finite and lies in [0, 1]; a singular configuration gives 0, never NaN.
 #include "model/coordinates.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Closed-chain inertia of one five-bar leg in actuated coordinates, base fixed (docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia):
+// Closed-chain inertia of one five-bar leg in actuated coordinates, base fixed (docs/reference/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia):
 // M_a = sum over links of (m Jv' Jv + I Jw' Jw), every link velocity written as a function of the two hip
 // rates through the loop closure (five-bar knee rates). Rotor inertia is not included: RACI adds it through
 // the drive constant k. Independent of the full-body dynamics on purpose (a second, simpler derivation).

@@ -1,5 +1,5 @@
 #pragma once
-// Conservative convex polygon fit of a gridded preferable set (docs/five-bar-theory.md#the-polygon-fit; the paper's conditions 1
+// Conservative convex polygon fit of a gridded preferable set (docs/reference/five-bar-theory.md#the-polygon-fit; the paper's conditions 1
 // and 2). Cells are axis-aligned boxes around grid nodes. A bad cell is excluded by edge k when its whole box
 // lies beyond that edge; the polygon is feasible when every bad cell is excluded by some edge, so it never
 // touches a bad cell. Greedy shrink from a seed, exact offset ascent, angle pattern search and vertex cuts,

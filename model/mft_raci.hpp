@@ -1,5 +1,5 @@
 #pragma once
-// Robot acceleration capacity index (RACI, paper eq. 5) of one five-bar leg, as defined in docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia:
+// Robot acceleration capacity index (RACI, paper eq. 5) of one five-bar leg, as defined in docs/reference/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia:
 // gamma_RACI = max_i tau~_i [N/sqrt(kg)], the worst normalized motor torque T_motor,i / sqrt(J_m) needed for any
 // foot acceleration |a| <= a_max at zero velocity, with u_i = row i of J^-1 and w_i = row i of M_a J^-1.
 //   optimal ratio (default): tau~_i* = a_max sqrt(2 (|u_i||w_i| + u_i.w_i) / eta_g)   (k chosen per configuration)
@@ -39,7 +39,7 @@ struct RaciResult {
 
 RaciResult computeRaci(const FiveBarGeometry& g, const LegInertiaParams& m, const FiveBarPose& p, const RaciOptions& o);
 
-// J^-1 at a pose in the closed form of docs/five-bar-theory.md#inverse-jacobian-in-closed-form (finite at output singularities, infinite at input ones).
+// J^-1 at a pose in the closed form of docs/reference/five-bar-theory.md#inverse-jacobian-in-closed-form (finite at output singularities, infinite at input ones).
 Eigen::Matrix2d fiveBarInverseJacobian(const FiveBarGeometry& g, const FiveBarPose& p);
 
 }  // namespace mft::model

@@ -1,5 +1,5 @@
 #pragma once
-// Live tuning of the planner (docs/live-tuning.md): a swing, foot-placement or height-rate key of
+// Live tuning of the planner (docs/guide/live-tuning.md): a swing, foot-placement or height-rate key of
 // config/planner.yaml changed while the planner runs. Judged off the control loop by config/planner.yaml's own
 // strict loader (applyPlannerOverride); swapped in at a tick boundary by MotionPlanner::setTuning (a copy of a
 // few doubles, allocation-free). Gait timing and command limits are structure, not tunable.

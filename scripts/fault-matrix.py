@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""fault-matrix: runs the stack's fault matrix (docs/faults.md) and writes a Markdown table and JSON.
+"""fault-matrix: runs the stack's fault matrix (docs/results/faults.md) and writes a Markdown table and JSON.
 
 Every row starts a fresh realtime stack (services/mft-supervisor up, recording with mft-record), lets it
 settle, applies one fault, watches, stops the stack and reads every service's summary:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Where a tick's time goes: the per-hop table of one traced run (docs/loop-benchmark.md).
+"""Where a tick's time goes: the per-hop table of one traced run (docs/results/loop-benchmark.md).
 
 Reads the <service>.hops.csv files that the services write when MFT_HOP_TRACE names a folder
 (`MFT_HOP_TRACE=DIR services/mft-supervisor run ...`, or scripts/measure-stack.py) and splits each tick

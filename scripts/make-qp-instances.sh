@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the QP instance set tests/data/qp (docs/qp-instances.md): the WBC's own QPs, dumped by
+# Regenerates the QP instance set tests/data/qp (docs/reference/qp-instances.md): the WBC's own QPs, dumped by
 # mft-closedloop --dump-qp from closed-loop runs (stand, step, walk, pushes, both controllers), a window of
 # consecutive ticks per run. Deterministic: the closed loop runs on the simulator's clock and the same inputs give
 # the same files, byte for byte.
@@ -24,7 +24,7 @@ run() {
   echo "$name: $count instances from t = $from s"
 }
 
-# Windows picked where the runs exercise the constraints (docs/qp-instances.md lists what is active where).
+# Windows picked where the runs exercise the constraints (docs/reference/qp-instances.md lists what is active where).
 run stand_mft 1.500 10 --stand --height 0.40                                    # double support, nothing active
 run step_mft 0.990 20 --height 0.44                                              # first lift-off, MFT rows
 run walk_mft 1.670 25 --speed 0.3                                                # a touchdown while walking

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# make-security.sh: makes the DDS Security material of a secured mft-wbc stack (docs/security.md) in DIR:
+# make-security.sh: makes the DDS Security material of a secured mft-wbc stack (docs/guide/security.md) in DIR:
 # a test CA, one identity per service (sim, estimator, planner, wbc, record) and one for the operator tool
 # mft-cmd (cmd), the governance document and one permissions document per identity, all signed by the CA
 # with openssl smime. Key material is never written inside the repository.
@@ -7,7 +7,7 @@
 #   scripts/make-security.sh DIR [--profile data|full] [--days N] [--cn-prefix TEXT] [--force]
 #
 # Per identity: <name>.pem (certificate), <name>.key (private key, mode 600), permissions_<name>.p7s;
-# shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/security.md).
+# shared: ca.pem, governance.p7s (ca.key stays in DIR too: this is a test CA, see docs/guide/security.md).
 # Permissions: those of the topic registry idl/topics.yaml (its writers and readers; the recorder reads every
 # recorded topic): each service may publish only its own topics (only the sim SensorData/GroundTruth, only the
 # WBC JointCommand); cmd publishes the operator's commands and reads the CommandVerdict answering them.
@@ -18,7 +18,7 @@ usage() {
   echo
   echo "Options:"
   echo "  --profile data   governance with data-only ENCRYPT on every topic, discovery and liveliness encrypted,"
-  echo "                   RTPS messages and submessage metadata not protected (the cheaper option, docs/dds.md#security; default)"
+  echo "                   RTPS messages and submessage metadata not protected (the cheaper option, docs/reference/dds.md#security; default)"
   echo "  --profile full   everything ENCRYPT (rtps, metadata, data, discovery, liveliness)"
   echo "  --days N         validity of the certificates and permissions (default 365)"
   echo "  --cn-prefix T    prefix of every certificate's common name (default empty; a second CA made with the"
@@ -65,7 +65,7 @@ umask 077
 cd "$DIR"
 
 # Who may publish / subscribe what: the writers and readers of the topic registry (idl/topics.yaml,
-# docs/architecture.md#the-topic-registry), one line per identity and direction: "<id> pub|sub <topics...>".
+# docs/reference/architecture.md#the-topic-registry), one line per identity and direction: "<id> pub|sub <topics...>".
 GRANTS="$(python3 "$REPO/idl/gen_topics.py" security)" || { echo "make-security: cannot read the topic registry idl/topics.yaml" >&2; exit 2; }
 IDENTITIES=()
 declare -A PUB=() SUB=()
@@ -74,7 +74,7 @@ while read -r id dir topics; do
 done <<< "$GRANTS"
 
 echo "make-security: test CA and ${#IDENTITIES[@]} identities in $DIR (profile $PROFILE, $DAYS days)"
-# EC P-256 everywhere (docs/dds.md#security: works with Fast DDS 2.9.1 and OpenSSL 3).
+# EC P-256 everywhere (docs/reference/dds.md#security: works with Fast DDS 2.9.1 and OpenSSL 3).
 openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -keyout ca.key -out ca.pem \
   -days "$DAYS" -sha256 -subj "/C=DE/O=mft-wbc/CN=${CN_PREFIX}mft-wbc test CA" 2>/dev/null
 for id in "${IDENTITIES[@]}"; do
@@ -92,7 +92,7 @@ else
 fi
 cat > governance.xml <<EOF
 <?xml version="1.0" encoding="UTF-8"?>
-<!-- mft-wbc governance, profile '$PROFILE' (docs/security.md): no unauthenticated participant may join;
+<!-- mft-wbc governance, profile '$PROFILE' (docs/guide/security.md): no unauthenticated participant may join;
      every topic is access controlled and its data encrypted. -->
 <dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="omg_shared_ca_domain_governance.xsd">
   <domain_access_rules>
@@ -136,7 +136,7 @@ for id in "${IDENTITIES[@]}"; do
     echo '<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="omg_shared_ca_permissions.xsd">'
     echo '  <permissions>'
     echo "    <grant name=\"${id}_grant\">"
-    # RFC 2253 order, the reverse of the -subj string (docs/dds.md#security, trap 2).
+    # RFC 2253 order, the reverse of the -subj string (docs/reference/dds.md#security, trap 2).
     echo "      <subject_name>CN=${CN_PREFIX}${id}, O=mft-wbc, C=DE</subject_name>"
     echo "      <validity><not_before>$NOT_BEFORE</not_before><not_after>$NOT_AFTER</not_after></validity>"
     echo '      <allow_rule>'

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""measure-security: what DDS Security costs the stack (docs/security.md). Runs step-in-place through the
+"""measure-security: what DDS Security costs the stack (docs/guide/security.md). Runs step-in-place through the
 supervisor plain and secured (material from scripts/make-security.sh in a temporary directory, removed after)
 and reports the realtime sensor-to-command latency (p50/p99 of the simulator's SensorData(k) -> JointCommand(k)
 round trip through estimator, planner and WBC) and the lockstep wall time of a 10 s run. A measurement, not a

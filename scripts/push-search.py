@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""push-search: the largest forward push each controller recovers from while stepping in place (docs/closed-loop.md,
+"""push-search: the largest forward push each controller recovers from while stepping in place (docs/guide/closed-loop.md,
 "Push recovery"). For every actuator model, controller and height it runs
 
   mft-closedloop --config-dir <copy with actuators.model = M> --height H --controller C --duration 10

@@ -2,7 +2,7 @@
 # Runs one CTest test again and again, each run in a private network namespace, until it fails or COUNT runs
 # passed; optionally with one CPU kept busy by a busy loop this script starts (and stops, by pid). Prints a
 # line per run (duration, load average) and a summary; the output of every run is kept in a file.
-# Test reliability figures in docs/testing.md come from this script.
+# Test reliability figures in docs/guide/testing.md come from this script.
 set -u
 
 usage() {

@@ -3,7 +3,7 @@
 # multi-process stack (mft-sim, mft-estimator, mft-planner, mft-wbc on DDS, lockstep) playing the `demo`
 # scenario through the supervisor, with a printed summary. Logs and summaries go to runs/; every topic is
 # recorded to the MRPT rawlog runs/demo-<date>-<time>.rawlog (the summary's "recording" line; see
-# docs/recording.md for mft-replay and mft-export).
+# docs/guide/recording.md for mft-replay and mft-export).
 # Extra arguments go to the supervisor, e.g. --mode realtime, --json, --domain 5.
 set -euo pipefail
 cd "$(dirname "$0")/.."

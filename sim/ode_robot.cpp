@@ -26,7 +26,7 @@ struct PlanarState {
 dBodyID makeBody(dWorldID world, const PlanarState& s, double mass, double inertia) {
   dBodyID b = dBodyCreate(world);
   dMass m;
-  // Mass centred on the body origin (docs/simulation.md#bodies-and-masses). Isotropic inertia: only the pitch moment matters in
+  // Mass centred on the body origin (docs/reference/simulation.md#bodies-and-masses). Isotropic inertia: only the pitch moment matters in
   // the plane, and an isotropic tensor has no gyroscopic term whatever the body's orientation.
   dMassSetParameters(&m, mass, 0, 0, 0, inertia, inertia, inertia, 0, 0, 0);
   dBodySetMass(b, &m);

@@ -1,6 +1,6 @@
 #pragma once
 // Internal: the robot's ODE bodies, joints and geoms, built from a closed-loop state in the model's
-// generalized coordinates, and read back into them. Frame mapping (docs/simulation.md#frames): project (x, y, z) -> ODE
+// generalized coordinates, and read back into them. Frame mapping (docs/reference/simulation.md#frames): project (x, y, z) -> ODE
 // (x, z, -y), a Y-up world, so a model angle (CCW about -y) is an ODE angle about +z, unchanged.
 #include <ode/ode.h>
 
@@ -53,7 +53,7 @@ void buildRobot(dWorldID world, const model::RobotDescription& d, const SimOptio
                 const model::VectorQ& q, const model::VectorQ& qd, OdeRobot* robot);
 void destroyRobotGeoms(OdeRobot* robot);
 
-// After each physics step: unwrap encoders and pitch, re-project the torso into the plane (docs/simulation.md#frames).
+// After each physics step: unwrap encoders and pitch, re-project the torso into the plane (docs/reference/simulation.md#frames).
 void updateRobotAfterStep(OdeRobot* robot, bool fixed_torso);
 
 // Generalized coordinates and velocities of the current ODE state.

@@ -1,5 +1,5 @@
 #pragma once
-// Series elastic actuator as the joint sees it (docs/five-bar-theory.md#robot-parameters-and-the-sea): the closed torque loop behaves as
+// Series elastic actuator as the joint sees it (docs/reference/five-bar-theory.md#robot-parameters-and-the-sea): the closed torque loop behaves as
 //   tau'' + 2 zeta w tau' + w^2 tau = w^2 tau_in,
 // integrated exactly for an input held over one physics step, so the response does not depend on the
 // substep count. The motor limits act on tau_in (the drive cannot command more): output peak torque, and no
@@ -38,7 +38,7 @@ class SeaActuator {
 // 2 % settling time of the loop's step response (for reports and tests), by simulation at step h.
 double seaSettlingTime(double w, double zeta, double h);
 
-// The physical SEA behind that filter (docs/five-bar-theory.md#robot-parameters-and-the-sea), all in output-side units: a motor with reflected
+// The physical SEA behind that filter (docs/reference/five-bar-theory.md#robot-parameters-and-the-sea), all in output-side units: a motor with reflected
 // inertia J_r = n^2 J_m and reflected viscous friction b_r (on the motor speed), a spring k_s to the joint, and
 // the drive's torque loop
 //   tau_m = tau_d + Kp (tau_d - tau_s) - Kd dtau_s/dt,   tau_s = k_s (theta_m - theta_j),

@@ -33,7 +33,7 @@ struct SimOptions {
 
   // World.
   double erp = 0.2;
-  double cfm = 1e-10;  // keep tiny: soften contacts, never the joints (docs/simulation.md#stepper-erp-and-cfm)
+  double cfm = 1e-10;  // keep tiny: soften contacts, never the joints (docs/reference/simulation.md#stepper-erp-and-cfm)
   LoopClosureJoint loop_closure = LoopClosureJoint::Ball;
   bool fix_torso = false;  // torso held still where it is placed (boom locked): swing and actuator tests
 

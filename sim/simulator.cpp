@@ -70,7 +70,7 @@ struct Simulator::Impl {
   std::array<double, kNa> applied{};  // joint torque of the last physics step (the SEA torque sensor)
   SensorNoise noise;
 
-  // Contacts: the feedback pool is sized once and never reallocated during a step (docs/simulation.md#contacts).
+  // Contacts: the feedback pool is sized once and never reallocated during a step (docs/reference/simulation.md#contacts).
   std::vector<dContact> buffer;
   std::vector<dJointFeedback> feedback;
   std::vector<int> feedback_leg;
@@ -110,7 +110,7 @@ void Simulator::Impl::nearCallback(void* data, dGeomID o1, dGeomID o2) {
     if (leg >= 0 && self->n_feedback >= self->feedback.size()) break;  // pool full: keep the rows we have
     const double mu = self->terrain_desc->frictionAt(c.geom.pos[0]);
     c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM | dContactMu2 | dContactFDir1;
-    c.surface.mu = mu >= 0.0 ? mu : self->friction;  // Approx1: a Coulomb coefficient (docs/simulation.md#contacts)
+    c.surface.mu = mu >= 0.0 ? mu : self->friction;  // Approx1: a Coulomb coefficient (docs/reference/simulation.md#contacts)
     c.surface.mu2 = 0.0;
     c.surface.soft_erp = self->soft_erp;
     c.surface.soft_cfm = self->soft_cfm;
@@ -186,7 +186,7 @@ Simulator::Simulator(const model::RobotDescription& robot, const SimOptions& opt
   const double kp = options_.contact_override_description ? options_.contact_stiffness_Npm : robot_.contact_stiffness_Npm;
   const double kd = options_.contact_override_description ? options_.contact_damping_Nspm : robot_.contact_damping_Nspm;
   m.friction = options_.contact_override_description ? options_.friction_coefficient : robot_.friction_coefficient;
-  // Spring-damper contacts from the physics step (docs/simulation.md#contacts).
+  // Spring-damper contacts from the physics step (docs/reference/simulation.md#contacts).
   m.soft_erp = h_ * kp / (h_ * kp + kd);
   m.soft_cfm = 1.0 / (h_ * kp + kd);
   m.terrain = std::make_unique<OdeTerrain>(terrain_, options_.foot_collision_radius_m);

@@ -28,7 +28,7 @@ struct WbcDiagnostics {
   std::array<double, kMaxDiagTasks> task_residual{};
   int num_tasks = 0;
   // MFT indices of the current configuration [right, left]: LTI from q; RACI [N/sqrt(kg)] from the hip angles
-  // (docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia), +inf at a singularity, NaN if the hips cannot close the loop.
+  // (docs/reference/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia), +inf at a singularity, NaN if the hips cannot close the loop.
   std::array<double, model::kNumLegs> lti{};
   std::array<double, model::kNumLegs> raci{{std::numeric_limits<double>::quiet_NaN(),
                                             std::numeric_limits<double>::quiet_NaN()}};

@@ -1,6 +1,6 @@
 #pragma once
 // The paper's Problem 1 one equation at a time (RBDL style): plain data in, matrices out, one function per
-// equation, numbered as published (docs/theory.md). The WBC's terms (wbc_formulation.cpp) call these every tick;
+// equation, numbered as published (docs/reference/theory.md). The WBC's terms (wbc_formulation.cpp) call these every tick;
 // the tests call them directly. Rows are written over the whole QP variable x = [qdd (11) | f_c (4) | eps (12)]
 // and sized here (fixed capacity: no allocation).
 #include <Eigen/Core>

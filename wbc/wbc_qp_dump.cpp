@@ -1,4 +1,4 @@
-// WholeBodyController::writeLastQp: the last tick's QP in the WBCQP v1 format (docs/qp-instances.md#file-format).
+// WholeBodyController::writeLastQp: the last tick's QP in the WBCQP v1 format (docs/reference/qp-instances.md#file-format).
 #include <cstdio>
 #include <stdexcept>
 

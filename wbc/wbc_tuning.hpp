@@ -1,5 +1,5 @@
 #pragma once
-// Live tuning of the WBC (docs/live-tuning.md): a `weights.*` or `gains.*` key of config/wbc.yaml changed while
+// Live tuning of the WBC (docs/guide/live-tuning.md): a `weights.*` or `gains.*` key of config/wbc.yaml changed while
 // the controller runs. A change is judged off the control loop by config/wbc.yaml's own strict loader
 // (applyWbcOverride) and swapped in at a tick boundary by WholeBodyController::setTuning, which copies a few
 // doubles and allocates nothing.

@@ -97,7 +97,7 @@ void WholeBodyController::fillStateDiagnostics(const model::RobotStateEstimate& 
   if (!state.q.allFinite()) return;
   for (int leg = 0; leg < model::kNumLegs; ++leg) {
     diag->lti[leg] = model::legTransmissionIndex(state.q, leg);
-    // RACI depends on the hip angles only (docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia); +inf at a singularity, NaN if unreachable.
+    // RACI depends on the hip angles only (docs/reference/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia); +inf at a singularity, NaN if unreachable.
     model::FiveBarPose pose;
     if (model::fiveBarForward(leg_geometry_, state.q[model::hipRearIndex(leg)], state.q[model::hipForeIndex(leg)],
                               &pose) == model::FiveBarStatus::Ok)

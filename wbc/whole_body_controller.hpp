@@ -73,7 +73,7 @@ class WholeBodyController {
   const DynamicsTerms& dynamicsTerms() const { return dyn_; }
   const model::PlanarModel& planarModel() const { return model_; }
 
-  // Writes the last tick's QP in the WBCQP v1 format (docs/qp-instances.md#file-format) with named variable and
+  // Writes the last tick's QP in the WBCQP v1 format (docs/reference/qp-instances.md#file-format) with named variable and
   // row blocks, and the solution as x_ref/f_ref/active_ref if it was optimal. The instance is named `name`
   // (default wbc_<tick>). Call right after update() of the tick to dump (from a non-realtime thread: it
   // allocates and does file I/O). Throws std::runtime_error if there is no problem yet or the file cannot be

@@ -2,7 +2,7 @@
 one parameter (default: the slack weight w_eps) with the stepping height for each value.
 
 Variants: "defaults" (no profile: the paper's setup), one per configuration profile in CONFIG/profiles/ (each the
-project's departure from the paper, applied alone, docs/profiles.md), and "rule-no-fall" (the defaults judged by
+project's departure from the paper, applied alone, docs/guide/profiles.md), and "rule-no-fall" (the defaults judged by
 the other outcome of the recovery criterion: no fall within the run instead of back to stepping in place).
 Each (variant, height, controller) cell is searched like push-sweep (default: --search coarse, 0.5 N s steps
 from 3 N s, then 0.1 N s at the first coarse failure). Sensitivity: for every value of --param (a dotted key

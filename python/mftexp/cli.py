@@ -24,7 +24,7 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
               default: I_50 / I_90, I_max per phase, outcomes by cause; table.md, heatmaps.png, probability.png
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
-  worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/experiments.md)
+  worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/results/experiments.md)
 
 Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
 keeps what finished (exit status 130) and stops every stack this tool started."""
@@ -95,7 +95,7 @@ def add_common(p, workers=True):
     p.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help="configuration folder (default %(default)s)")
     p.add_argument("--profile", action="append", default=[], metavar="NAME",
                    help="configuration profile config/profiles/NAME.yaml (repeatable, applied in order; default: "
-                        "none, the paper's setup; docs/profiles.md); passed to the supervisor")
+                        "none, the paper's setup; docs/guide/profiles.md); passed to the supervisor")
     p.add_argument("--domain-base", type=domain_id, default=90,
                    help="DDS domain of the first stack; stack i uses domain-base + i (default %(default)s: "
                         "no test uses 90-99; the integration tests take 100-219)")
@@ -110,7 +110,7 @@ def add_common(p, workers=True):
 
 
 def add_distributed(p):
-    g = p.add_argument_group("several machines (Dask distributed; docs/experiments.md#several-machines)")
+    g = p.add_argument_group("several machines (Dask distributed; docs/results/experiments.md#several-machines)")
     g.add_argument("--scheduler", metavar="ADDRESS",
                    help="run every stack run as a task on the workers of this Dask scheduler (tcp://HOST:8786) "
                         "instead of --workers stacks here; results.jsonl, the table and resuming are the same")
@@ -202,7 +202,7 @@ def add_case_command(sub):
     c = sub.add_parser("case", help="one push, both controllers, the paper's Fig. 6",
                        description="One push at one height with both controllers (recorded), and the paper's "
                                    "Fig. 6 as a PNG: hip joint angles of both legs; base height, pitch and speed; "
-                                   "and both runs side by side as a video (case.mp4, docs/videos.md).")
+                                   "and both runs side by side as a video (case.mp4, docs/guide/videos.md).")
     c.add_argument("--height", type=height, default=0.44, help="reference base height [m] (default 0.44)")
     c.add_argument("--impulse", type=positive, default=7.1, help="impulse [N s] (default 7.1, the paper's case)")
     c.add_argument("--controllers", type=controllers_list, default=["mft", "sa"], help="default mft,sa")
@@ -230,7 +230,7 @@ def add_terrain_command(sub):
     t.add_argument("--out", help="output folder (default runs/terrain-<time>)")
     t.add_argument("--paper-setup", action="store_true",
                    help="without the profile kv-0.145 that the scenario otherwise carries (with the paper's k_v = 0.16 "
-                        "the robot stalls on the slope; docs/experiments.md#terrain-fig-8)")
+                        "the robot stalls on the slope; docs/results/experiments.md#terrain-fig-8)")
     add_common(t)
     _video.add_video_options(t)
 
@@ -279,7 +279,7 @@ def add_ablation_command(sub):
 
 def add_worker_command(sub):
     """worker: a Dask worker with this clone's build."""
-    w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/experiments.md)",
+    w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/results/experiments.md)",
                        description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "
                                    "its services (--bin-dir) as the binaries of every run; runs until stopped "
                                    "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/python "

@@ -177,7 +177,7 @@ def write_report(path, report, png, t0, as_json):
 
 
 def profile_options(profiles):
-    """--profile NAME for each configuration profile (config/profiles/, docs/profiles.md), in order."""
+    """--profile NAME for each configuration profile (config/profiles/, docs/guide/profiles.md), in order."""
     return [a for name in (profiles or []) for a in ("--profile", name)]
 
 

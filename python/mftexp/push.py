@@ -35,7 +35,7 @@ class PushSetup:
     fall_base_height_m: float = 0.25
     fall_pitch_rad: float = 0.8
     criteria: Criteria = field(default_factory=Criteria)
-    profiles: list = field(default_factory=list)  # configuration profiles (docs/profiles.md); [] = the paper's setup
+    profiles: list = field(default_factory=list)  # configuration profiles (docs/guide/profiles.md); [] = the paper's setup
 
     def key(self):
         """What makes two runs with the same height, controller and impulse the same run."""

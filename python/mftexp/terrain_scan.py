@@ -1,7 +1,7 @@
 """terrain-scan: how often blind walking gets over the course, over the gait's phase at the board.
 
 A blind walk meets the board's leading edge wherever the gait puts its footfalls: a foot that lands in the last
-2-3 cm before the 3 cm board brings its fore shank onto the corner (docs/experiments.md#terrain-fig-8). Where the
+2-3 cm before the 3 cm board brings its fore shank onto the corner (docs/results/experiments.md#terrain-fig-8). Where the
 footfalls fall at the edge is set by the gait's phase there, and so by how far the course starts from the robot.
 One run of `terrain` is therefore one draw. This command walks the whole course in process (mft-closedloop, the
 same configs, profiles and fall criteria as the stack) with the course shifted by each offset
@@ -128,7 +128,7 @@ def _scan_run(args, job, configs, course, progress, left):
 def _flat_height(args, out, cell):
     """The base's mean height walking on flat ground (2-8 s), the cell's setup otherwise: what shapes the legs
     when they reach the board (with the paper's contact-force weight it sits below the command,
-    docs/profiles.md)."""
+    docs/guide/profiles.md)."""
     h, v, c = cell
     scen = out / "scenarios" / f"flat-h{h:.3f}-v{v:.3f}-{c}.yaml"
     write_yaml_scenario(scen, walk_scenario(h, v, c, "flat", 8.0, f"terrain-scan-flat-{c}", "terrain-scan"))

@@ -1,5 +1,5 @@
 """Run videos of an experiment's recorded runs, side by side on one clock (`mft-export A --video OUT --beside B`,
-docs/videos.md): `case` shows the same push with both controllers (the paper's Fig. 6 in motion), `terrain` the
+docs/guide/videos.md): `case` shows the same push with both controllers (the paper's Fig. 6 in motion), `terrain` the
 course. --no-video skips them."""
 import json
 import subprocess

@@ -1,4 +1,4 @@
-"""mftstack: the Python side of mft-wbc (docs/architecture.md "Python package").
+"""mftstack: the Python side of mft-wbc (docs/reference/architecture.md "Python package").
 
   paths       the repository, built executables, configuration and runs folders (one place)
   processes   the supervised service processes: argv, start order, readiness, restart back-off, logs, stop

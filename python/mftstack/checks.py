@@ -1,7 +1,7 @@
 """Everything checked before the first service starts: options, executables, configuration files (each
 service's --check-config), the scenario, the --record target, DDS Security material, the stack file's
 hosts, and a DDS domain nobody else uses (mft-participants). Each refusal is one line (exit status 2);
-docs/faults.md "Bad input and misuse"."""
+docs/results/faults.md "Bad input and misuse"."""
 import json
 import os
 import subprocess
@@ -18,7 +18,7 @@ REQUIRED_CONFIG = ["robot.yaml", "sim.yaml", "estimator.yaml", "planner.yaml", "
                    "dds_profiles.xml"]
 # Before it starts anything, the supervisor asks mft-participants who is on the domain (a second stack on one
 # domain hears the first one's commands). It listens this long: discovery of a running participant on loopback
-# took 92-368 ms on this 2-core VM under a load average of 15-40 (docs/faults.md), so 1 s leaves a margin.
+# took 92-368 ms on this 2-core VM under a load average of 15-40 (docs/results/faults.md), so 1 s leaves a margin.
 DOMAIN_PROBE_TOOL = "mft-participants"
 DOMAIN_PROBE_WAIT_MS = 1000
 # Set in the detached `up --foreground` child: its parent has just checked the domain.

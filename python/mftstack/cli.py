@@ -16,11 +16,11 @@ Service contract (every mft-<service> executable):
 
 Before it starts anything the supervisor validates the scenario, runs every service's --check-config, refuses
 an existing --record file (unless --overwrite) and refuses a DDS domain on which participants already answer
-(`mft-participants`, from each host of a stack file). docs/faults.md "Bad input and misuse" lists every case.
+(`mft-participants`, from each host of a stack file). docs/results/faults.md "Bad input and misuse" lists every case.
   `--profile NAME` (repeatable) applies the configuration profile config/profiles/NAME.yaml after the
-  scenario's own `profiles` (docs/profiles.md); the supervisor passes its --profile options to every service.
+  scenario's own `profiles` (docs/guide/profiles.md); the supervisor passes its --profile options to every service.
 
-Multi-host (`--stack FILE`, docs/distributed.md): a stack file names hosts (an address, optionally a network
+Multi-host (`--stack FILE`, docs/guide/distributed.md): a stack file names hosts (an address, optionally a network
 namespace), places each service on one, and chooses discovery by initial peers or a Fast DDS discovery server.
 The supervisor writes one DDS profile per host into the run folder (the project's profile bound to the host's
 address, with every host's address as initial peer or the server as discovery server), starts each service
@@ -301,7 +301,7 @@ def run_dir_warnings(run_dir):
 def live_changes(run_dir):
     """The changes mft-cmd --set made while the stack runs, per service, oldest first: mft-wbc and mft-planner
     list them in <run_dir>/<service>.tuning.json, rewritten (whole) by a thread of the service after each change
-    (docs/live-tuning.md). A service that takes none has an empty list; one without the file is not listed."""
+    (docs/guide/live-tuning.md). A service that takes none has an empty list; one without the file is not listed."""
     out = {}
     for path in sorted(Path(run_dir).glob("*.tuning.json")):
         try:
@@ -376,7 +376,7 @@ def stack_options(sp):
     sp.add_argument("--config-dir", default=str(DEFAULT_CONFIG), help=f"configuration folder (default {DEFAULT_CONFIG})")
     sp.add_argument("--profile", action="append", metavar="NAME",
                     help="configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, "
-                         "applied in order; docs/profiles.md)")
+                         "applied in order; docs/guide/profiles.md)")
     sp.add_argument("--run-dir", help="folder for logs and summaries (default runs/<scenario>-<time>-d<domain>)")
     sp.add_argument("--no-rt", action="store_true", help="realtime mode: do not ask for SCHED_FIFO")
     sp.add_argument("--stall-probe", action="store_true", help="realtime: run the simulator's CPU stall probe "
@@ -385,24 +385,24 @@ def stack_options(sp):
     sp.add_argument("--rt-priorities", choices=["chain", "flat"], default="chain", help="realtime: SCHED_FIFO "
                     "priorities rising along the chain to the simulator (chain, the default: estimator 76, planner "
                     "77, wbc 78, sim 79; with the chain on one core each hand-off is a same-core preemption) or 80 "
-                    "for all (flat); docs/loop-benchmark.md")
+                    "for all (flat); docs/results/loop-benchmark.md")
     sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
                     "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
     sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "
                     "wbc) to CPU N and the recorder to the other CPUs: every hand-off of a tick stays on one core "
                     "(lockstep: faster, and recording costs less; realtime: a shorter and steadier sensor-to-command "
-                    "latency; docs/loop-benchmark.md); auto (the default): on the CPU the stack's domain picks "
+                    "latency; docs/results/loop-benchmark.md); auto (the default): on the CPU the stack's domain picks "
                     "(domain modulo the CPUs allowed), --stack unpinned; none: no pinning")
     sp.add_argument("--chain-transport", choices=["shm", "dds"],
                     help="how the chain's topics go from service to service: shm (a shared-memory segment per "
                     "stack, a hop about one thread wake-up; DDS still carries every topic to every reader outside "
                     "the chain, and the chain still hears DDS writers from outside the stack, such as mft-inject) "
                     "or dds (DDS alone). Default: shm. --secure and --stack always use DDS "
-                    "(docs/loop-benchmark.md)")
+                    "(docs/results/loop-benchmark.md)")
     sp.add_argument("--secure", metavar="DIR", help="DDS Security: authenticate, access-control and encrypt with the "
-                    "identities in DIR (scripts/make-security.sh; docs/security.md)")
+                    "identities in DIR (scripts/make-security.sh; docs/guide/security.md)")
     sp.add_argument("--stack", metavar="FILE", help="multi-host: place each service on a host of this stack file "
-                    "(config/stacks/*.yaml; docs/distributed.md); default: every service here on 127.0.0.1")
+                    "(config/stacks/*.yaml; docs/guide/distributed.md); default: every service here on 127.0.0.1")
     sp.add_argument("--host", metavar="NAME", help="with --stack: start only the services placed on this host (one "
                     "supervisor per machine; 'run' on the simulator's host, 'up' on the others)")
 

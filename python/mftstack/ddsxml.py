@@ -1,11 +1,11 @@
-"""Per-host DDS profiles of a stack file (docs/distributed.md): the project's dds_profiles.xml bound to each
+"""Per-host DDS profiles of a stack file (docs/guide/distributed.md): the project's dds_profiles.xml bound to each
 host's address, with initial peers or a discovery server, and the discovery server's own profile."""
 import xml.etree.ElementTree as ET
 
 from .errors import SupervisorError
 
 DISCOVERY_SERVER = "discovery-server"  # the stack's Fast DDS discovery server (discovery: server)
-DISCOVERY_SERVER_PREFIX = "44.53.00.5f.45.50.52.4f.53.49.4d.41"  # server id 0 (docs/dds.md#discovery-server)
+DISCOVERY_SERVER_PREFIX = "44.53.00.5f.45.50.52.4f.53.49.4d.41"  # server id 0 (docs/reference/dds.md#discovery-server)
 DDS_XMLNS = "http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles"
 # Fast DDS tries an initial peer's address on the ports of participant ids 0..N-1 (default 4): a host may
 # run up to this many participants (services plus mft-cmd/mft-inject by hand) and still be found.

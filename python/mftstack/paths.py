@@ -1,7 +1,7 @@
 """Where things are: the repository, the built executables, the configuration and the runs folder. The one
 place for these defaults; MFT_BIN_DIR and MFT_RUNS_DIR override them (as CTest and the tests do).
 
-Two layouts (docs/library.md#layout-of-an-install):
+Two layouts (docs/guide/library.md#layout-of-an-install):
 - the source tree: python/mftstack beside config/ and services/, executables in build/release/bin, runs in runs/;
 - an install (cmake --install, the .deb): <prefix>/share/mft_wbc/python/mftstack beside
   <prefix>/share/mft_wbc/config, executables and mft-supervisor in <prefix>/bin, runs in ./runs (the prefix

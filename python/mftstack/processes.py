@@ -1,7 +1,7 @@
 """Service processes: start in order, readiness, restart with back-off, PR_SET_PDEATHSIG, logs, stop.
 
 Stack builds every service's command line (the service contract, with the host's DDS profile of a stack
-file, docs/distributed.md) and supervises the processes; Service is one child with its log and summary."""
+file, docs/guide/distributed.md) and supervises the processes; Service is one child with its log and summary."""
 import json
 import os
 import re
@@ -43,10 +43,10 @@ def chain_cpu_for(chain_cpu, mode, domain, multi_host):
 
     A tick is a relay (sim -> estimator -> planner -> wbc -> sim) in which one process runs at a time: on one
     core every hand-off is a local wake-up, while a wake-up on another, idle, vCPU costs tens of us on a VM
-    (docs/loop-benchmark.md). "auto" pins the chain of a single-host stack to one of the CPUs this process may
+    (docs/results/loop-benchmark.md). "auto" pins the chain of a single-host stack to one of the CPUs this process may
     use, chosen by its DDS domain, so that the stacks of mft-experiment's local workers (consecutive domains)
     each get their own core; multi-host stacks (--stack) are not pinned by "auto". Measured
-    (docs/loop-benchmark.md): in lockstep the pinned chain ran a tick in ~0.7x the time of the unpinned one;
+    (docs/results/loop-benchmark.md): in lockstep the pinned chain ran a tick in ~0.7x the time of the unpinned one;
     in realtime (with the priorities rising along the chain) the sensor-to-command p50 fell ~3x and its p99
     ~1.7x on a 2-vCPU VM."""
     if chain_cpu is None:
@@ -138,7 +138,7 @@ def chain_shm_name(args, multi_host):
 # simulator, which consumes the chain's end product (the command). With the chain on one core each hand-off
 # (estimator -> planner -> wbc) preempts the writer at once, and the WBC's command preempts the WBC itself: the
 # simulator has it before the writers' post-write work runs. "flat" runs them all at 80. Measured
-# (docs/loop-benchmark.md, "The realtime tail, measure by measure"): with the simulator lowest instead
+# (docs/results/loop-benchmark.md, "The realtime tail, measure by measure"): with the simulator lowest instead
 # (sim 76 ... wbc 79) the command waited for the estimator's and the planner's remaining work, p50 +50-100 us.
 RT_CHAIN_PRIORITIES = {"mft-estimator": 76, "mft-planner": 77, "mft-wbc": 78, "mft-sim": 79}
 
@@ -271,7 +271,7 @@ class Stack:
         if getattr(args, "secure", None):
             common += ["--secure", str(Path(args.secure).resolve())]  # each service takes its own identity
         if args.mode == "realtime" and not args.no_rt:
-            common.append("--rt")  # SCHED_FIFO keeps the 1 kHz tail short under load (docs/dds.md#scheduling-and-latency)
+            common.append("--rt")  # SCHED_FIFO keeps the 1 kHz tail short under load (docs/reference/dds.md#scheduling-and-latency)
         names = list(CORE_SERVICES)
         if args.record:
             names.append("mft-record")
@@ -426,7 +426,7 @@ ANSI_ESCAPE = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
 
 
 def tail(path, n):
-    """The last n lines of a service log, without Fast DDS's colour codes (docs/dds.md#log-output)."""
+    """The last n lines of a service log, without Fast DDS's colour codes (docs/reference/dds.md#log-output)."""
     try:
         lines = Path(path).read_text(errors="replace").splitlines()
     except OSError:

@@ -93,7 +93,7 @@ class SimLog:
 class fifo_priority:
     """Runs a block at SCHED_FIFO 85, above the realtime stack's 80, where permitted: a fault (a SIGSTOP, a cut)
     timed by a normal-priority sleep lasts longer than asked on a busy machine (tens of ms, once 1.2 s:
-    docs/distributed.md)."""
+    docs/guide/distributed.md)."""
 
     def __init__(self, priority=85):
         self.priority = priority

@@ -1,4 +1,4 @@
-"""Multi-host stack files (`--stack FILE`, docs/distributed.md): strict loading and the checks of the hosts
+"""Multi-host stack files (`--stack FILE`, docs/guide/distributed.md): strict loading and the checks of the hosts
 they name against this machine (network namespaces, addresses, the discovery server executable)."""
 import ipaddress
 import os

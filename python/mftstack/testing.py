@@ -1,4 +1,4 @@
-"""The one helper the multi-process tests run stacks with (docs/testing.md "Running a stack in a test").
+"""The one helper the multi-process tests run stacks with (docs/guide/testing.md "Running a stack in a test").
 
 StackRunner starts services/mft-supervisor the way a user does, in a temporary folder with a runs folder of its
 own (MFT_RUNS_DIR: state files and logs never meet another test's), and close() ends whatever it started,

@@ -1,4 +1,4 @@
-"""The topic registry (docs/architecture.md#the-topic-registry): idl/topics.yaml (where each topic goes) with the
+"""The topic registry (docs/reference/architecture.md#the-topic-registry): idl/topics.yaml (where each topic goes) with the
 fields of its message from idl/mft_msgs.idl, read and checked. The one place the scripts learn the topics from
 (scripts/fault-matrix.py, scripts/make-security.sh through idl/gen_topics.py), and what idl/gen_topics.py
 generates the C++ descriptors, the ROS 2 package and the docs' table from."""

@@ -1,5 +1,5 @@
 #pragma once
-// mft-planner's operator commands from the OperatorCommand topic (mft-cmd, docs/operator-commands.md). Each is
+// mft-planner's operator commands from the OperatorCommand topic (mft-cmd, docs/guide/operator-commands.md). Each is
 // judged on arrival against the planner's fixed limits and answered on CommandVerdict (rejected with the reason,
 // or scheduled); a valid one waits here for the planner's next tick, which applies it before its plan (after the
 // scenario's commands of that tick: the operator has the last word) and names the tick in an `applied` verdict.

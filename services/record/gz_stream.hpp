@@ -1,7 +1,7 @@
 #pragma once
 // gzip streams for rawlogs on zlib directly, as mrpt::io::CStream subclasses so CArchive can use them.
 //  * GzWriteStream: CFileGZOutputStream has no flush(), so a crash loses up to one zlib buffer, unbounded in
-//    time (docs/mrpt.md#write-stalls-and-flushing). This one calls gzflush(Z_SYNC_FLUSH) on request: the file is then readable
+//    time (docs/reference/mrpt.md#write-stalls-and-flushing). This one calls gzflush(Z_SYNC_FLUSH) on request: the file is then readable
 //    up to that point by MRPT's own reader and rawlog-edit even without the gzip trailer.
 //  * GzReadStream: CFileGZInputStream hides zlib's errors; this one keeps them, so a reader can tell a clean
 //    end from a truncated file (no gzip trailer) and from corrupt data.

@@ -25,7 +25,7 @@ int reportConfigOk(const services::CommandLine& cli) {
 int toolMain(int argc, char** argv) {
   services::CommandLine cli("mft-record",
                             "Records every topic to an MRPT rawlog (observations-only format, standard classes,\n"
-                            "metadata comment first, sidecar FILE.yaml). See docs/recording.md.");
+                            "metadata comment first, sidecar FILE.yaml). See docs/guide/recording.md.");
   services::declareRecordOptions(cli);
   cli.parse(argc, argv);
   services::installShutdownHandlers();

@@ -245,7 +245,7 @@ std::string metadataYaml(const Metadata& m) {
   e << YAML::Key << "profiles" << YAML::Value << YAML::Flow << m.profiles;
   e << YAML::Comment("config/profiles/ in force; config below holds the files with them applied");
   e << YAML::Key << "dds_naming" << YAML::Value << m.dds_naming;
-  e << YAML::Comment("ros2: topics rt/mft/<snake_case>, types mft::msg::dds_::<Name>_ (docs/interop.md)");
+  e << YAML::Comment("ros2: topics rt/mft/<snake_case>, types mft::msg::dds_::<Name>_ (docs/guide/interop.md)");
   e << YAML::Key << "time_base_unix_ns" << YAML::Value << m.time_base_unix_ns;
   e << YAML::Comment("observation timestamp = time_base_unix_ns + stamp_ns of the simulator clock");
   e << YAML::Key << "piece" << YAML::Value << m.piece;

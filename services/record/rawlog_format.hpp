@@ -1,5 +1,5 @@
 #pragma once
-// The mft rawlog format (docs/recording.md, docs/mrpt.md): an MRPT observations-only rawlog ("format #2") whose
+// The mft rawlog format (docs/guide/recording.md, docs/reference/mrpt.md): an MRPT observations-only rawlog ("format #2") whose
 // first object is a CObservationComment holding the run's metadata as YAML, followed by standard MRPT
 // observations, one or more per DDS message:
 //   CObservationRawDAQ for every topic (AIN_double: the channels, channel 0 = tick or seq; schema 2 adds the
@@ -54,7 +54,7 @@ int labelIndex(const std::string& label);  // -1 if unknown
 // The label indices of one topic, in writing order.
 const std::vector<int>& topicLabels(Topic t);
 
-// TTimeStamp <-> UNIX nanoseconds (integer math: never through double, docs/mrpt.md#timestamps).
+// TTimeStamp <-> UNIX nanoseconds (integer math: never through double, docs/reference/mrpt.md#timestamps).
 mrpt::Clock::time_point toMrptTime(std::int64_t unix_ns);
 std::int64_t fromMrptTime(mrpt::Clock::time_point t);
 

@@ -2,7 +2,7 @@
 // Streaming reader of mft rawlogs: checks that the file is one (first object = mft metadata comment of a
 // supported schema version) before anything else, then yields observations one by one and tells how the
 // file ended: cleanly, truncated (a recorder killed mid-write: everything up to the last whole record is
-// read), or corrupt (reading stops at the damage). Never loads the whole file (docs/mrpt.md#reading-as-a-stream).
+// read), or corrupt (reading stops at the damage). Never loads the whole file (docs/reference/mrpt.md#reading-as-a-stream).
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/serialization/CArchive.h>
 

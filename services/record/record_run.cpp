@@ -18,7 +18,7 @@ void declareRecordOptions(CommandLine& cli) {
   ServiceContext::declareOptions(cli);
   cli.option("output", "the rawlog to write (later pieces: <stem>.partNNN<ext>); an existing recording is refused", "", true);
   cli.flag("overwrite", "replace an existing recording at --output (its sidecar and pieces too)");
-  cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (docs/mrpt.md#compression-level)", "1");
+  cli.option("gzip-level", "0 (stored) .. 9; 1 is fastest and nearly as small (docs/reference/mrpt.md#compression-level)", "1");
   cli.option("flush-ms", "flush period: a crash loses about this much [ms] (at most 100)", "50");
   cli.option("queue", "capacity of the queue between DDS and the writer [messages]", "65536");
   cli.option("split-mb", "start a new piece past this compressed size [MB] (0 = never)", "0");

@@ -98,7 +98,7 @@ void Recorder::stop() {
 }
 
 void Recorder::writerLoop() {
-  // gzip calls stall for up to milliseconds (docs/mrpt.md#write-stalls-and-flushing). Under SCHED_FIFO (realtime stacks) this
+  // gzip calls stall for up to milliseconds (docs/reference/mrpt.md#write-stalls-and-flushing). Under SCHED_FIFO (realtime stacks) this
   // thread runs at FIFO priority 1: below every control thread (80), which it never delays, yet above the
   // machine's ordinary load, which could otherwise starve it past the flush period (crash loss). Otherwise at
   // nice 0 even if the service is niced: it needs little CPU, but promptly.
@@ -201,7 +201,7 @@ void Recorder::writeSample(const Sample& s) {
   }
   const auto stamp = static_cast<std::int64_t>(s.stamp_ns);
   if (!have_time_base_) {
-    // Stamps are wall clock at the first sample + simulator time (docs/mrpt.md#timestamps: never UNIX 0), whole ms.
+    // Stamps are wall clock at the first sample + simulator time (docs/reference/mrpt.md#timestamps: never UNIX 0), whole ms.
     // From the sample's arrival, not from now: it may have waited in the reorder window.
     const std::int64_t arrival_unix = unixNs() - (steadyNs() - s.arrival_ns);
     opt_.metadata.time_base_unix_ns = (arrival_unix - stamp) / 1'000'000 * 1'000'000;

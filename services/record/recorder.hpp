@@ -1,7 +1,7 @@
 #pragma once
 // The recorder's engine, independent of DDS: DDS callbacks push() messages into a bounded, preallocated
 // queue (a copy under a short lock; a full queue drops and counts, never blocks), and one writer thread
-// (docs/mrpt.md#writing-from-one-thread: a CArchive is not thread-safe) sorts them by simulator time in a small reorder window,
+// (docs/reference/mrpt.md#writing-from-one-thread: a CArchive is not thread-safe) sorts them by simulator time in a small reorder window,
 // drops repeated ticks, encodes them as MRPT observations and writes the rawlog through a gzip stream that
 // is flushed at least every flush period, so a crash loses at most that much. Optional split by size or
 // duration into self-contained pieces (metadata repeated); a sidecar YAML per piece.
@@ -24,7 +24,7 @@ namespace mft::rawlog {
 struct RecorderOptions {
   std::string output;             // first piece; later pieces are <stem>.partNNN<ext>
   int first_piece = 0;            // > 0 after a restart: never overwrite what a crashed recorder left
-  int gzip_level = 1;             // docs/mrpt.md#compression-level
+  int gzip_level = 1;             // docs/reference/mrpt.md#compression-level
   double flush_period_s = 0.1;
   std::size_t queue_capacity = 1 << 16;
   double split_mb = 0.0;          // 0 = no split by size (compressed MB)

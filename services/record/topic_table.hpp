@@ -194,7 +194,7 @@ struct TopicTable {
 // Lockstep: publishes how far the recorder has read its socket (the simulator waits when this falls more than its
 // --recorder-window behind), from the main loop every 5 ms, not per sample: no cost per tick. Nothing until every
 // 1 kHz topic flows: the simulator holds tick 0 until then, so that no writer's first samples go out before it has
-// matched the recorder (docs/dds.md#samples-before-matching). Unchanged progress is repeated every 50 ms.
+// matched the recorder (docs/reference/dds.md#samples-before-matching). Unchanged progress is repeated every 50 ms.
 class ProgressReporter {
  public:
   void update(const TopicTable& topics, RecordParticipant& participant) {

@@ -1,5 +1,5 @@
 #pragma once
-// The chain's shared-memory channel (docs/loop-benchmark.md, "The shared-memory chain channel"): the topics
+// The chain's shared-memory channel (docs/results/loop-benchmark.md, "The shared-memory chain channel"): the topics
 // the chain passes along (SensorData, GroundTruth, RobotState, Reference, JointCommand) and the WBC's diagnostics
 // (the rows of idl/topics.yaml with `chain: true`) go between the processes of one stack (the four chain services
 // and the recorder) through a POSIX shared-memory segment the supervisor names, instead of through the DDS stack.

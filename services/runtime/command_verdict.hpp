@@ -1,5 +1,5 @@
 #pragma once
-// The stack's answer to an operator command (docs/operator-commands.md): the planner judges OperatorCommand,
+// The stack's answer to an operator command (docs/guide/operator-commands.md): the planner judges OperatorCommand,
 // the simulator Disturbance, and each posts a CommandVerdict (rejected with the reason, scheduled, applied at a
 // tick) that mft-cmd waits for. Verdicts are judged inside the services' tick paths, which must neither
 // allocate nor block on a reliable write: post() only formats into a preallocated ring, and a thread of the

@@ -56,7 +56,7 @@ std::string checkProfilesFile(const std::string& profiles_file);
 struct DiscoveryOptions {
   // The names of the stack's participants, comma-separated (the supervisor's --stack-services), announced in this
   // participant's user data: a peer learns from any one member which services the stack has, including those it
-  // has not discovered yet (mft-cmd waits for every reader of its request, docs/operator-commands.md).
+  // has not discovered yet (mft-cmd waits for every reader of its request, docs/guide/operator-commands.md).
   std::string stack_services;
   // Keep the list of the participants discovered (discoveredParticipants()): a participant listener that runs on
   // Fast DDS's discovery thread only. Tools (mft-cmd) turn it on; the services do not.
@@ -77,7 +77,7 @@ class DdsParticipant {
  public:
   // Loads `profiles_file` (throws if it is missing or malformed) and creates a participant with the
   // "mft_participant" profile on `domain_id`. `name` identifies the service in discovery. With `security`
-  // enabled the participant authenticates with that identity (docs/security.md).
+  // enabled the participant authenticates with that identity (docs/guide/security.md).
   // `receive` tunes the receive path (socket buffer, polling; polling_udp_transport.hpp).
   // `discovery`: what it announces and whether it keeps the participants it discovers (DiscoveryOptions).
   DdsParticipant(int domain_id, const std::string& profiles_file, const std::string& name,

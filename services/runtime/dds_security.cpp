@@ -18,7 +18,7 @@ void applySecurity(const SecurityOptions& security, eprosima::fastdds::dds::Doma
   if (ec || !fs::is_directory(dir))
     throw DdsError("--secure: " + security.dir + " is not a directory (make one with scripts/make-security.sh DIR)");
   const std::string id = security.identity;
-  // Fast DDS 2.9 accepts only file:// URIs with an absolute path (docs/dds.md#security, trap 1).
+  // Fast DDS 2.9 accepts only file:// URIs with an absolute path (docs/reference/dds.md#security, trap 1).
   auto uri = [&](const std::string& file) {
     const fs::path p = dir / file;
     if (!fs::is_regular_file(p))

@@ -1,6 +1,6 @@
 #pragma once
 // DDS Security (PKI-DH authentication, Access-Permissions, AES-GCM-GMAC) for one participant: the dds.sec.*
-// properties of an identity in a directory made by scripts/make-security.sh (docs/security.md). An empty
+// properties of an identity in a directory made by scripts/make-security.sh (docs/guide/security.md). An empty
 // directory means an unsecured participant, exactly as before.
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Where a lockstep tick's time goes (docs/loop-benchmark.md): each service stamps named marks of tick k
+// Where a lockstep tick's time goes (docs/results/loop-benchmark.md): each service stamps named marks of tick k
 // (input received, answer written, ...) with the system-wide monotonic clock, so the stamps of different
 // processes compare, and writes them as <dir>/<service>.hops.csv at exit. Off unless the environment variable
 // MFT_HOP_TRACE names a directory (scripts/measure-stack.py --hops sets it); then the table is allocated once at

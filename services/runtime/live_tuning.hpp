@@ -1,5 +1,5 @@
 #pragma once
-// Live tuning on the service side (docs/live-tuning.md): mft-wbc and mft-planner read ConfigChange requests
+// Live tuning on the service side (docs/guide/live-tuning.md): mft-wbc and mft-planner read ConfigChange requests
 // (mft-cmd --set), judge each off the control loop with their configuration's strict loader, answer on
 // CommandVerdict (rejected with the loader's message, or scheduled), and swap the judged parameters in at a tick
 // boundary: in lockstep at the first tick at or after the requested simulated time (a time already passed is

@@ -1,9 +1,9 @@
 #pragma once
 // Every floating-point field of a received message must be finite and physically plausible (|v| <= 1e4 in
 // SI units: no 10 km position, 10 km/s speed or 10 kN m torque on a 0.4 m robot) before a service lets it
-// overwrite its state (docs/faults.md): such a sample is refused and counted, the service keeps its last good
+// overwrite its state (docs/results/faults.md): such a sample is refused and counted, the service keeps its last good
 // input, and the real sample of the same tick is still answered. Wrong values inside the plausible range
-// cannot be told from real ones here: that is what DDS Security's access control is for (docs/security.md).
+// cannot be told from real ones here: that is what DDS Security's access control is for (docs/guide/security.md).
 // One overload per input topic.
 #include <cmath>
 

@@ -20,11 +20,11 @@ void ServiceContext::declareOptions(CommandLine& cli) {
              "services rising priorities along the chain)", "80");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "
-             "comma list; docs/profiles.md)");
+             "comma list; docs/guide/profiles.md)");
   cli.option("profiles", "DDS QoS profile file (default: dds_profiles.xml of --config-dir; a multi-host stack gives "
-             "each host its own: its address, its peers or discovery server, docs/distributed.md)");
+             "each host its own: its address, its peers or discovery server, docs/guide/distributed.md)");
   cli.option("chain-shm", "chain services: also carry the chain's topics through this POSIX shared-memory "
-             "segment (/mft-chain-…; the supervisor names one per stack; docs/loop-benchmark.md)");
+             "segment (/mft-chain-…; the supervisor names one per stack; docs/results/loop-benchmark.md)");
   cli.option("stack-services", "the names of the stack's services, comma-separated (the supervisor gives them): "
              "announced in DDS discovery, so that mft-cmd waits for every reader of a request, the recorder included");
   cli.flag("check-config", "load every configuration file this service reads (strict loaders) and the DDS profile "

@@ -1,11 +1,11 @@
 #pragma once
-// Which ticks a service answers (docs/faults.md). Each service answers tick k once and ignores older ticks;
+// Which ticks a service answers (docs/results/faults.md). Each service answers tick k once and ignores older ticks;
 // without a guard a single sample with a tick far ahead (a corrupted or injected one) made it ignore every
 // real tick after it for good, and a restarted simulator (its clock back at 0) was ignored for as long as
 // the old clock had run. The gate accepts a jump of more than `max_jump` ticks ahead, or a fall back by more
 // than `max_jump` (a new clock), only when the next sample continues it: one stray sample is refused, a real
 // new timeline costs one tick. A consistent forged timeline cannot be told from a real one here: DDS
-// Security's access control keeps such writers out (docs/security.md). Pure logic, unit-tested
+// Security's access control keeps such writers out (docs/guide/security.md). Pure logic, unit-tested
 // (tests/faults/test_input_guards.cpp).
 #include <cstdint>
 

@@ -1,5 +1,5 @@
 #pragma once
-// The part every chain service repeats around its node (docs/faults.md): pair the inputs of tick k, refuse what
+// The part every chain service repeats around its node (docs/results/faults.md): pair the inputs of tick k, refuse what
 // must not reach the node, answer each tick once and a repeated tick with the cached answer. Inputs that are not
 // finite or implausible are refused and counted (msg_guard.hpp), the service keeps its last good input; the
 // tick-naming input passes the TickGate (a stray far tick is refused, a restarted simulator is followed). Pure

@@ -1,7 +1,7 @@
 #pragma once
 // Typed topic writers and readers on a DdsParticipant, created from a named QoS profile.
 // The reader delivers every valid sample to a callback on the DDS receive thread (the cheapest path at
-// 1 kHz, docs/dds.md#transport-and-qos) and counts deadline misses, liveliness changes and matched writers.
+// 1 kHz, docs/reference/dds.md#transport-and-qos) and counts deadline misses, liveliness changes and matched writers.
 // In a chain service whose participant has the chain channel open (chain_channel.hpp), the chain topics with the
 // chain's profiles go through shared memory: the writer puts each sample in the topic's slot and sends it over DDS
 // only while a reader outside the chain is matched (the recorder, mft-inject --listen, a ROS 2 reader); the reader
@@ -247,7 +247,7 @@ class TopicReader : public eprosima::fastdds::dds::DataReaderListener {
   }
   std::uint64_t deadlineMissesOutsideStream() const { return misses_before_stream_.load() + misses_pending_.load(); }
   // The same measured here: gaps between two consecutive samples' arrivals longer than the deadline period (0
-  // without a deadline). Fast DDS's timer fires up to a millisecond early (docs/dds.md#deadline-and-liveliness-timing),
+  // without a deadline). Fast DDS's timer fires up to a millisecond early (docs/reference/dds.md#deadline-and-liveliness-timing),
   // so its count above includes misses no sample gap shows.
   std::uint64_t gapsOverDeadline() const { return gaps_over_deadline_.load(); }
   DeadlineCounts deadlineCounts() const {

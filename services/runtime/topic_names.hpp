@@ -1,6 +1,6 @@
 // DDS topic names. The code names a topic by its message type ("SensorData"); on the wire it is the name ROS 2
 // gives topic /mft/sensor_data: "rt/" + "mft/" + the snake_case name, so ROS 2 tools (ros2 topic echo, rosbag2,
-// PlotJuggler, Foxglove) see our topics with the ros2/mft message package (docs/interop.md#ros-2).
+// PlotJuggler, Foxglove) see our topics with the ros2/mft message package (docs/guide/interop.md#ros-2).
 #pragma once
 
 #include <cctype>

@@ -1,5 +1,5 @@
 // mft-sim: the simulator stage of the chain (chain/sim_node.hpp) as a service. It owns the clock
-// (docs/architecture.md#clock-and-loop-modes):
+// (docs/reference/architecture.md#clock-and-loop-modes):
 //  lockstep: publish GroundTruth(k) and SensorData(k), wait for JointCommand(k), step; deterministic, as fast
 //            as the chain answers; a missing answer is a named timeout error (exit status 3).
 //  realtime: step on the wall clock at 1 kHz, hold the newest command; the actuator driver

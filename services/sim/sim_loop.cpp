@@ -22,7 +22,7 @@ void SimLoop::declareOptions(CommandLine& cli) {
              "                             the machine's stalls from the chain's misses; costs ~30 us of p50 latency\n"
              "                             on a 2-vCPU VM; 0 = off) [us]", "0");
   cli.option("spin-us", "realtime: wake this long before each 1 kHz deadline and poll the clock to it (0 = sleep to\n"
-             "                             the deadline; docs/loop-benchmark.md) [us]", "0");
+             "                             the deadline; docs/results/loop-benchmark.md) [us]", "0");
   cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
   cli.option("recorder-window", "lockstep: never run more than this many ticks ahead of mft-record's progress "
                                 "(0 = no recorder flow control; the supervisor sets it when recording)", "0");

@@ -1,5 +1,5 @@
 #pragma once
-// How mft-sim gets the command for tick k after publishing its state (docs/architecture.md#clock-and-loop-modes):
+// How mft-sim gets the command for tick k after publishing its state (docs/reference/architecture.md#clock-and-loop-modes):
 //  lockstep: waits for JointCommand(k), re-sending tick k while the answer is late (the chain is best effort: a
 //            lost sample costs one re-send; every service answers a repeated tick with its cached answer); tick 0
 //            of a recorded run is also held until the recorder receives every topic; the run's wall time starts

@@ -1,5 +1,5 @@
 #pragma once
-// Pushes from the Disturbance topic (mft-cmd, docs/operator-commands.md): each request is checked on arrival
+// Pushes from the Disturbance topic (mft-cmd, docs/guide/operator-commands.md): each request is checked on arrival
 // (chain/input_guard.hpp) and answered on CommandVerdict: rejected with the reason, or scheduled; once the
 // simulator applies it, applied with the time and tick of the physics step that carried it. Fixed capacity:
 // the loop never allocates; a request beyond it is rejected.

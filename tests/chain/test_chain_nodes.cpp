@@ -129,7 +129,7 @@ TEST(SimNode, PlaysAPushAtAGaitPhaseWhereThePlannerSaysItIs) {
   EXPECT_TRUE(blind.pushes().phasePushesWaiting());
 }
 
-// The layer rule (docs/architecture.md): the chain library includes no transport, no recording and nothing of
+// The layer rule (docs/reference/architecture.md): the chain library includes no transport, no recording and nothing of
 // services/, so a robot's bridge or the in-process loop can use it without them.
 TEST(ChainLibrary, IncludesNoTransportNoRecordingNoServices) {
   const std::filesystem::path dir = std::filesystem::path(MFT_CONFIG_DIR).parent_path() / "chain";

@@ -63,8 +63,8 @@ TEST_P(SteppingInPlace, HoldsItsPlaceWithoutFalling) {
   std::printf("%s at %.2f m: mean base height %.4f m, max MFT violation %.4f rad\n", c.controller, c.height,
               s.mean_base_z, s.max_mft_violation);
   // Both variants track the command less the predicted sag (the 4 mm band covers the estimator's 2 mm height
-  // bias, docs/closed-loop.md). Up to 0.44 m the sagged stance lies inside the MFT polytope (the hexagon holds
-  // the vertical stance up to 0.435 m, docs/mft-space.md), so the MFT rows are inactive and MFT-WBC steps like
+  // bias, docs/guide/closed-loop.md). Up to 0.44 m the sagged stance lies inside the MFT polytope (the hexagon holds
+  // the vertical stance up to 0.435 m, docs/guide/mft-space.md), so the MFT rows are inactive and MFT-WBC steps like
   // SA-WBC; at 0.46 m it lies outside.
   const double expected = c.height - predictedSag(configs(), 1);
   if (std::string(c.controller) == "sa" || c.height < 0.45) {
@@ -85,7 +85,7 @@ TEST_P(SteppingInPlace, HoldsItsPlaceWithoutFalling) {
   }
 }
 
-// The old departures as profiles (docs/profiles.md): with slack-1e5 and contact-weights-small, MFT-WBC holds the
+// The old departures as profiles (docs/guide/profiles.md): with slack-1e5 and contact-weights-small, MFT-WBC holds the
 // polytope's edge at 0.44 m (the hexagon's vertical stance limit 0.435 m; the paper saw about 0.43 m).
 TEST(SteppingWithProfiles, Slack1e5HoldsThePolytopeEdgeAt044) {
   const Configs c = loadConfigs(MFT_CONFIG_DIR, {"slack-1e5", "contact-weights-small"});

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measures the three-host stack's network behaviour for docs/distributed.md (root; namespaces made and
+"""Measures the three-host stack's network behaviour for docs/guide/distributed.md (root; namespaces made and
 deleted here, testnet.py). Each row is a fresh realtime stack (sim | wbc | estimator+planner[+recorder]),
 through mft-supervisor --stack, on its own namespaces:
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The stack on three hosts (docs/distributed.md): Linux network namespaces made by the test (testnet.py) on a
+"""The stack on three hosts (docs/guide/distributed.md): Linux network namespaces made by the test (testnet.py) on a
 private subnet 10.77.<domain>.0/24, joined by veths through a bridge in a switch namespace; the simulator on
 `robot`, the WBC on `ctrl`, estimator, planner and recorder on `aux`, started through
 `mft-supervisor --stack`. Faults on the veth links: nftables random loss, tc tbf, link down.
@@ -33,8 +33,8 @@ from mftstack.testing import BIN, REPO, SCENARIOS, StackTestCase  # noqa: E402
 
 CHAIN_TOPICS = ["GroundTruth", "SensorData", "RobotState", "Reference", "JointCommand", "WbcDiagnostics"]
 PERMITTED, WHY_NOT = netns_permitted()
-# Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/distributed.md):
-# the cut test stands (0.40 m), as the fault tests do (docs/faults.md).
+# Stepping in place, 200 ms without a controller make the robot fall for good (measured, docs/guide/distributed.md):
+# the cut test stands (0.40 m), as the fault tests do (docs/results/faults.md).
 CUT_SCENARIO = "stand.yaml"
 STAND_HEIGHT_M = 0.40
 
@@ -189,7 +189,7 @@ class DistributedTest(StackTestCase):
         detail = f"link down {cut_lo * 1e3:.0f}-{cut_hi * 1e3:.0f} ms, damping episodes {sim['damping_episodes']}"
         self.assertGreater(duration_ms, 150.0, detail)      # the cut, not a stray late command
         # Commands came back soon after the link did, judged against the link's real down time: the `ip` command
-        # that brings it back can itself take long on the busy VM even at SCHED_FIFO 85 (docs/distributed.md), and
+        # that brings it back can itself take long on the busy VM even at SCHED_FIFO 85 (docs/guide/distributed.md), and
         # a fixed bound on the damping then fails the harness, not the stack. 400 ms is the old bound (600 ms of
         # damping) less the nominal 200 ms cut; measured recoveries are -2 to +39 ms after the link.
         self.assertLess(silent_ms - cut_hi * 1e3, 400.0, detail)
@@ -255,7 +255,7 @@ class DistributedTest(StackTestCase):
             f"ticks answered {ticks}, sim wall {sim['wall_time_s']:.2f} s")
 
     def test_7_secured_three_hosts_lockstep(self):
-        """DDS Security (docs/security.md) across the hosts: the per-host profiles keep the secured path working."""
+        """DDS Security (docs/guide/security.md) across the hosts: the per-host profiles keep the secured path working."""
         domain = 231
         net, stack = self.network(domain)
         sec = self.tmp / "sec"
@@ -294,9 +294,9 @@ class DistributedTest(StackTestCase):
         # The test used to sleep 2 s and assert that the last damping episode ended 0.5 s before the stack was
         # stopped. With the other core busy that failed (last episode ended at 6.777 s, asserted 6.666 s): on a
         # loaded machine a single late command is a damping episode of its own, at any time (one run: 11 episodes
-        # of 1-30 ms in 18 s, before and after the limit, docs/testing.md), so also in those last 0.5 s. What
+        # of 1-30 ms in 18 s, before and after the limit, docs/guide/testing.md), so also in those last 0.5 s. What
         # holds under load is that the chain answers every tick again for a sustained stretch; 30 s only guards
-        # against a hang (the test prints when the stretch ended; docs/testing.md).
+        # against a hang (the test prints when the stretch ended; docs/guide/testing.md).
         cleared_after_s = sim_log.sim_time() + 1.0
         flowing_s = sim_log.wait_for_commands_flowing(cleared_after_s, timeout=30)
         s = self.down(domain, st)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The stack file of mft-supervisor --stack (docs/distributed.md), without network namespaces: strict checks
+"""The stack file of mft-supervisor --stack (docs/guide/distributed.md), without network namespaces: strict checks
 (every error names the file and the key, nothing starts), the per-host DDS profiles it writes, and a short
 lockstep run of config/stacks/local.yaml (every service on 127.0.0.1 through the stack-file path, DDS
 domain 230 on loopback; the namespace tests use their own networks)."""

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Test hosts as Linux network namespaces (docs/distributed.md), for the distributed tests and by hand.
+"""Test hosts as Linux network namespaces (docs/guide/distributed.md), for the distributed tests and by hand.
 
 A TestNet is N host namespaces, each with `lo` up and one veth `eth0` on a private /24, plugged into a bridge
 `br0` in a "switch" namespace of its own. Every command runs inside a namespace this module created (`ip -n`,

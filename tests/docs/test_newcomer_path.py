@@ -1,11 +1,11 @@
 """A newcomer's path, as the guide writes it: README -> first run -> a cell of Table II -> change a weight ->
-rerun the cell (docs/getting-started.md, "Your first hour").
+rerun the cell (docs/guide/getting-started.md, "Your first hour").
 
 The test takes the command blocks marked `<!-- newcomer-step: NAME -->` from the page and runs them in order, as
 written, in a scratch folder laid out like the repository (a copy of config/, the services and the built
 programs linked in, an empty runs/); only the DDS domain is changed to the test's own. Then it checks what they
 wrote against the numbers the pages quote: the README's Table II cell, and the ablation's slack-weight row of
-docs/experiments.md.
+docs/results/experiments.md.
 """
 import argparse
 import json
@@ -25,7 +25,7 @@ HEIGHT, CONTROLLER, GRID_NS = 0.44, "mft", 0.5
 
 
 def page_steps(source):
-    text = (source / "docs" / "getting-started.md").read_text()
+    text = (source / "docs" / "guide" / "getting-started.md").read_text()
     return [(name, body.replace("\\\n", " ")) for name, body in STEP.findall(text)]
 
 
@@ -40,8 +40,8 @@ def readme_table_ii(source, height):
 
 
 def ablation_slack_row(source, slack):
-    """docs/experiments.md's slack-weight table: I_max of MFT-WBC at 0.44 m for that slack weight."""
-    text = (source / "docs" / "experiments.md").read_text()
+    """docs/results/experiments.md's slack-weight table: I_max of MFT-WBC at 0.44 m for that slack weight."""
+    text = (source / "docs" / "results" / "experiments.md").read_text()
     row = re.search(r"^\| %d \| ([\d.]+) \| ([\d.]+) \|" % slack, text, re.M)
     return float(row.group(2))
 

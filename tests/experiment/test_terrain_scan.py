@@ -75,7 +75,7 @@ class TerrainScanTest(unittest.TestCase):
 
     def test_the_walking_height_shows_the_contact_weights_sag(self):
         # Table I's w_fc = 1e-3 holds the base below its command by w_fc m^2 g / (n_st w_z kp): 13.0 mm predicted in
-        # single support (docs/profiles.md, contact-weights-small; 15 mm measured stepping in place).
+        # single support (docs/guide/profiles.md, contact-weights-small; 15 mm measured stepping in place).
         self.assertEqual(self.r.returncode, 0, self.r.stderr[-2000:])
         (cell,) = json.loads(self.r.stdout)["cells"]
         sag = 0.44 - cell["walking_height_on_flat_m"]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Bad input and misuse of files and tools (issue 16, part 3; docs/faults.md "Files and tools"): every case
+"""Bad input and misuse of files and tools (issue 16, part 3; docs/results/faults.md "Files and tools"): every case
 is refused with one clear line and a documented exit status, fast, never an abort, a hang, a huge allocation
 or a result that looks fine. Single processes only; the services are refused before they create a DDS
 participant (domain 231 if one ever did)."""

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The key promises of the fault matrix (docs/faults.md) on real realtime stacks, bounded in time:
+"""The key promises of the fault matrix (docs/results/faults.md) on real realtime stacks, bounded in time:
   - NaN never reaches a torque: NaN joint commands injected as the newest command of every tick for 2 s are
     refused by the simulator's actuator driver, the measured actuator torques stay finite, no fall;
   - the simulator damps within 5 ms of a missed command deadline (the WBC stopped for 200 ms), and

@@ -1,4 +1,4 @@
-// The checks between the network and the robot (docs/faults.md): the simulator's actuator driver, the
+// The checks between the network and the robot (docs/results/faults.md): the simulator's actuator driver, the
 // services' input plausibility and the tick gate. Pure logic, no DDS traffic.
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """mft-cmd --set refuses a value outside the key's physical range, or text where a number belongs, before it
-sends anything (no stack is needed): the range is the configuration schema's (docs/config-reference.md).
+sends anything (no stack is needed): the range is the configuration schema's (docs/reference/config-reference.md).
 Before, 'planner.swing.lift_height_m=50' and 'planner.foot_placement.k_v=1e308' were applied by a running stack.
 Needs MFT_BIN_DIR (set by CTest)."""
 import os

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Adding a topic (docs/adding-a-topic.md), done for real: a copy of the source tree gets one new message in
+"""Adding a topic (docs/guide/adding-a-topic.md), done for real: a copy of the source tree gets one new message in
 idl/mft_msgs.idl and its row in idl/topics.yaml (recorded, with the next rawlog id), `gen_topics.py sync` rewrites
 the copies kept in the repository, and a build of only the tools that carry it (mft-inject, mft-record,
 mft-replay, mft-export, mft-cyclone) must then, with no other edit, publish it, hear it with `mft-inject --listen`
@@ -63,7 +63,7 @@ ROW = f"""
 """
 # What the procedure may touch: by hand the message and the row; `gen_topics.py sync` rewrites the kept copies.
 BY_HAND = {"idl/mft_msgs.idl", "idl/topics.yaml"}
-REWRITTEN_BY_SYNC = {"ros2/mft/msg/ScratchProbe.msg", "ros2/mft/CMakeLists.txt", "docs/architecture.md"}
+REWRITTEN_BY_SYNC = {"ros2/mft/msg/ScratchProbe.msg", "ros2/mft/CMakeLists.txt", "docs/reference/architecture.md"}
 
 
 def run(cmd, timeout, **kw):
@@ -176,7 +176,7 @@ class AddATopic(unittest.TestCase):
         self.assertIn("float64[3] value  # what the publisher sets", msg)
         self.assertIn("uint8 SCRATCH_MODE_ON=0", msg)
         self.assertIn("| `ScratchProbe` | `rt/mft/scratch_probe` | mft-cmd → mft-planner, mft-record | chain | no | yes |",
-                      (SRC / "docs" / "architecture.md").read_text())
+                      (SRC / "docs" / "reference" / "architecture.md").read_text())
 
     def test_2_published_and_heard_by_mft_inject(self):
         listener = self.inject("--listen", "ScratchProbe", "--wait-writers", 20, "--seconds", 2, background=True)

@@ -90,7 +90,7 @@ TEST(Msgs, EveryTopicTypeIsBoundedAndRoundTrips) {
   const auto back = roundTrip<mft::msg::CommandVerdict, mft::msg::CommandVerdictPubSubType>(verdict);
   EXPECT_TRUE(back == verdict);
   EXPECT_STREQ(back.reason().data(), reason);
-  mft::msg::ConfigChange change;  // live tuning (docs/live-tuning.md)
+  mft::msg::ConfigChange change;  // live tuning (docs/guide/live-tuning.md)
   change.seq(42);
   change.target(mft::msg::CONFIG_TARGET_PLANNER);
   const char key[] = "foot_placement.k_v", value[] = "0.145";

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The ROS 2 message package ros2/mft says exactly what idl/mft_msgs.idl says (docs/interop.md#ros-2): one .msg
+"""The ROS 2 message package ros2/mft says exactly what idl/mft_msgs.idl says (docs/guide/interop.md#ros-2): one .msg
 per struct of module mft::msg::dds_ (named <Name>_ as ROS 2's rmw_fastrtps names message <Name> of package
 mft), the same fields in the same order with the matching ROS 2 types and array sizes, every IDL constant once
 in the message that uses it, ROS 2's naming rules, and a package.xml / CMakeLists.txt that list it all. Parses

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The topic registry (idl/topics.yaml with idl/mft_msgs.idl, docs/architecture.md#the-topic-registry): the
+"""The topic registry (idl/topics.yaml with idl/mft_msgs.idl, docs/reference/architecture.md#the-topic-registry): the
 copies kept in the repository (ros2/mft, the docs' topic table) are what the registry makes of them, the
 permissions it gives are those the stack was secured with before it existed, and a bad row is refused with
 its reason."""

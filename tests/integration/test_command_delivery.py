@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Every reader the stack has gets mft-cmd's requests, the recorder included, or the loss is counted and named
-(docs/operator-commands.md, "Every reader gets it").
+(docs/guide/operator-commands.md, "Every reader gets it").
 
 One recorded realtime stack standing (`up --record`, domain 88). Live changes (`--set`), operator commands and
 pushes, applied and rejected, are sent three at a time: every request mft-cmd reports delivered to mft-record is

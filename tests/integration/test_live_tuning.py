@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Live tuning (docs/live-tuning.md): `mft-cmd --set` against real stacks through services/mft-supervisor.
+"""Live tuning (docs/guide/live-tuning.md): `mft-cmd --set` against real stacks through services/mft-supervisor.
 
 Lockstep (domain 98): the same 72 s standing run twice, recorded, once as it is and once with
 `--set wbc.gains.base_z.kp=100 --at 12` sent while it runs. The torques are identical up to the tick of 12 s
@@ -145,7 +145,7 @@ class LiveTuningInLockstep(unittest.TestCase):
         self.assertEqual(float(row["value_0"]), KP_AFTER)
         self.assertEqual(float(row["at_s"]), AT_S)
         # Every request is recorded as a request (applied 0), the refused ones too: mft-cmd waits until every reader
-        # of ConfigChange, the recorder included, has acknowledged it (docs/operator-commands.md#every-reader-gets-it);
+        # of ConfigChange, the recorder included, has acknowledged it (docs/guide/operator-commands.md#every-reader-gets-it);
         # only the change in force is an applied record.
         requests = [r for r in self.b["config_change"] if float(r["applied"]) == 0.0]
         for result in (self.set_result, self.no_at, self.passed):

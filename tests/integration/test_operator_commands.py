@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Operator commands reach the stack and its verdict reaches the operator (docs/operator-commands.md): real
+"""Operator commands reach the stack and its verdict reaches the operator (docs/guide/operator-commands.md): real
 mft-cmd processes against a real stack started through services/mft-supervisor (or single services), each test
 on its own DDS domain (90-93), bounded in time, every process cleaned up even on failure. Needs MFT_BIN_DIR
 (set by CTest) pointing at the built executables."""

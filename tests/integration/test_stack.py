@@ -27,7 +27,7 @@ class StackTest(StackTestCase):
     tmp_prefix = "mft-stack-test-"
 
     def test_lockstep_steps_in_place_with_ticks_matching_on_every_topic(self):
-        hops = self.stacks.path / "hops"  # the per-hop trace of this run (docs/loop-benchmark.md), checked at the end
+        hops = self.stacks.path / "hops"  # the per-hop trace of this run (docs/results/loop-benchmark.md), checked at the end
         hops.mkdir()
         code, s, err = self.stacks.run_json("step-in-place.yaml", DOMAIN_BASE,
                                             env=dict(self.stacks.env, MFT_HOP_TRACE=str(hops)))
@@ -41,7 +41,7 @@ class StackTest(StackTestCase):
             self.assertEqual(svc["last_tick"], 9999, name)    # on the simulator's clock
         self.assertEqual(s["services"]["mft-wbc"]["non_optimal_solves"], 0)
         self.assertEqual(s["wbc_safety_events"], 0)
-        # Lockstep: the chain ran on the one CPU its domain picks (docs/loop-benchmark.md).
+        # Lockstep: the chain ran on the one CPU its domain picks (docs/results/loop-benchmark.md).
         allowed = sorted(os.sched_getaffinity(0))
         self.assertEqual(s["chain_cpu"], allowed[DOMAIN_BASE % len(allowed)])
         sim = s["services"]["mft-sim"]

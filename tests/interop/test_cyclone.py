@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second DDS vendor on the stack (docs/interop.md): mft-cyclone, built with Eclipse Cyclone DDS from the
+"""A second DDS vendor on the stack (docs/guide/interop.md): mft-cyclone, built with Eclipse Cyclone DDS from the
 project's IDL, reads SensorData, JointCommand and Reference from a running Fast DDS stack (values sane, ticks
 increasing) and sends an OperatorCommand that the stack obeys; a height out of reach is rejected with the
 planner's reason. One realtime stack on DDS domain 226, started through the supervisor and stopped by it (by

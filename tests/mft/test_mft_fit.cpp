@@ -1,4 +1,4 @@
-// The conservative polygon fit (docs/five-bar-theory.md#the-polygon-fit): conditions 1 and 2 on the default robot, the numbers of
+// The conservative polygon fit (docs/reference/five-bar-theory.md#the-polygon-fit): conditions 1 and 2 on the default robot, the numbers of
 // section 3.4, the vertical stance inside/outside, and synthetic shapes with known answers.
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Paper (1)-(4): the transmission angle (1) and the limb powers (2) against closed forms, and the LTI closed forms
-// of docs/five-bar-theory.md#transmission-indices-lti against an independent screw-theory computation
+// of docs/reference/five-bar-theory.md#transmission-indices-lti against an independent screw-theory computation
 // (reciprocal products of the transmission wrench with the input and output twists, maxima by sampling force
 // directions), and singular configurations giving 0 without NaN. The test keeps its own planar screw types as
 // the oracle; the library's (2) is checked against them and against closed forms.

@@ -1,5 +1,5 @@
 // Leg inertia M_a against kinetic energy from finite differences of the kinematics; RACI against the
-// massless-link closed form of docs/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia, and the vertical stance numbers of docs/five-bar-theory.md#vertical-stance-numbers.
+// massless-link closed form of docs/reference/five-bar-theory.md#acceleration-capacity-raci-and-leg-inertia, and the vertical stance numbers of docs/reference/five-bar-theory.md#vertical-stance-numbers.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -131,7 +131,7 @@ TEST(MftRaci, SingularConfigurationsAreInfiniteNotNaN) {
 }
 
 TEST(MftRaci, VerticalStanceTableOfTheDesignNotes) {
-  // docs/five-bar-theory.md#vertical-stance-numbers: z_B, ITI, OTI, LTI, RACI* (optimal), RACI (k = 0.3), RACI* with gravity.
+  // docs/reference/five-bar-theory.md#vertical-stance-numbers: z_B, ITI, OTI, LTI, RACI* (optimal), RACI (k = 0.3), RACI* with gravity.
   struct Row {
     double z, iti, oti, lti, opt, fixed, grav;
   };

@@ -1,5 +1,5 @@
 // Five-bar leg kinematics: IK/FK round trips, the assembly mode, Jacobians and knee rates against central
-// finite differences, and the nominal stance numbers of docs/five-bar-theory.md#robot-parameters-and-the-sea.
+// finite differences, and the nominal stance numbers of docs/reference/five-bar-theory.md#robot-parameters-and-the-sea.
 #include <gtest/gtest.h>
 
 #include <random>

@@ -1,4 +1,4 @@
-// Live tuning, planner side (docs/live-tuning.md): a change of config/planner.yaml is judged by its strict loader,
+// Live tuning, planner side (docs/guide/live-tuning.md): a change of config/planner.yaml is judged by its strict loader,
 // gait timing is refused as structure, and every tunable planner key exists in the file.
 #include <gtest/gtest.h>
 

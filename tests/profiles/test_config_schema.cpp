@@ -1,6 +1,6 @@
 // The configuration schema (common/config_schema.hpp): every numeric key of every shipped file has a physical
 // range that the loaders, live tuning and mft-cmd --set enforce, text is not a number, and the reference
-// table in docs/config-reference.md is the schema's.
+// table in docs/reference/config-reference.md is the schema's.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -125,9 +125,9 @@ TEST(ConfigSchema, ListEntriesUseTheirListRange) {
   EXPECT_EQ(config::findKeyRange("planner", "swing.no_such_key"), nullptr);
 }
 
-// docs/config-reference.md holds the generated table between two markers; MFT_UPDATE_SCHEMA_DOC=1 rewrites it.
+// docs/reference/config-reference.md holds the generated table between two markers; MFT_UPDATE_SCHEMA_DOC=1 rewrites it.
 TEST(ConfigSchema, DocsTableIsTheSchema) {
-  const fs::path path = fs::path(MFT_CONFIG_DIR) / ".." / "docs" / "config-reference.md";
+  const fs::path path = fs::path(MFT_CONFIG_DIR) / ".." / "docs" / "reference" / "config-reference.md";
   std::string doc = readFile(path);
   const std::string begin = "<!-- schema begin -->\n", end = "<!-- schema end -->";
   const auto b = doc.find(begin), e = doc.find(end);

@@ -150,7 +150,7 @@ TEST(ShippedProfiles, EachLoadsAndChangesSomething) {
 }
 
 // Each shipped profile opens with comment lines naming itself and its reason, with a measurement or a named
-// reference (docs/profiles.md) behind it.
+// reference (docs/guide/profiles.md) behind it.
 TEST(ShippedProfiles, EachStatesItsReason) {
   for (const auto& name : shippedProfiles()) {
     SCOPED_TRACE(name);
@@ -161,7 +161,7 @@ TEST(ShippedProfiles, EachStatesItsReason) {
       if (line.rfind("#", 0) == 0) comments += line + "\n";
     EXPECT_EQ(text.rfind("# Profile " + name + ":", 0), 0u) << "the first line names the profile";
     EXPECT_NE(comments.find("Reason"), std::string::npos) << "no 'Reason' comment";
-    EXPECT_NE(comments.find("docs/profiles.md"), std::string::npos) << "no pointer to docs/profiles.md";
+    EXPECT_NE(comments.find("docs/guide/profiles.md"), std::string::npos) << "no pointer to docs/guide/profiles.md";
     EXPECT_GE(std::count(comments.begin(), comments.end(), '\n'), 3) << "a reason in at least three comment lines";
   }
 }

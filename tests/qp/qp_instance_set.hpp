@@ -1,5 +1,5 @@
 #pragma once
-// The project's QP instance set (tests/data/qp, format and origin in docs/qp-instances.md), loaded once per test
+// The project's QP instance set (tests/data/qp, format and origin in docs/reference/qp-instances.md), loaded once per test
 // binary, and what the tests ask of an instance: its run and which constraint kinds are active in its reference.
 #include <string>
 #include <utility>

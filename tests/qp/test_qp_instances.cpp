@@ -1,4 +1,4 @@
-// The solver on the project's own QP instance set (tests/data/qp, docs/qp-instances.md): QPs that the WBC built
+// The solver on the project's own QP instance set (tests/data/qp, docs/reference/qp-instances.md): QPs that the WBC built
 // in closed-loop runs (stand, step, walk, pushes, both controllers). The reference solutions in the files came
 // from the solver under test inside the WBC, so they are first checked without it: by active-set verification
 // (the reported active set held as equalities, the KKT system solved with Eigen, multiplier signs and KKT

@@ -69,7 +69,7 @@ QpProblem unconstrained(int n, int block, unsigned seed) {
 }  // namespace
 
 TEST(QpStatus, UnconstrainedStartIsMinusHInverseG) {
-  // docs/qp.md#unconstrained-start: eiquadprog's provided-factor path returns +J J' g. Ours must give -H^-1 g, dense or block-structured.
+  // docs/reference/qp.md#unconstrained-start: eiquadprog's provided-factor path returns +J J' g. Ours must give -H^-1 g, dense or block-structured.
   for (int block : {6, 3, 1}) {
     QpProblem p = unconstrained(6, block, 10 + block);
     const Eigen::VectorXd expected = -p.H.llt().solve(p.g);

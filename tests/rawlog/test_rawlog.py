@@ -98,7 +98,7 @@ class RecordedLockstepRun(unittest.TestCase):
     def test_2_rawlog_edit_lists_every_label_with_its_count(self):
         if not shutil.which("rawlog-edit"):
             self.skipTest("rawlog-edit (mrpt-apps) not installed")
-        # rawlog-edit writes side files next to its input's folder (docs/mrpt.md#rawlog-edit): run it in the file's folder.
+        # rawlog-edit writes side files next to its input's folder (docs/reference/mrpt.md#rawlog-edit): run it in the file's folder.
         p = run(["rawlog-edit", "--info", "-i", self.rawlog.name], cwd=self.rawlog.parent, timeout=120)
         self.assertEqual(p.returncode, 0, p.stderr)
         counts = {m.group(1): int(m.group(2)) for m in
@@ -218,7 +218,7 @@ class RecordedLockstepRun(unittest.TestCase):
     def test_7_recording_leaves_the_lockstep_run_unchanged(self):
         # The lockstep run is deterministic: recording must not change a single figure of it (it only adds
         # readers). The speed cost is reported here and measured properly by scripts/measure-stack.py
-        # (speed targets live in measurements, not in timed tests; docs/benchmarks.md "Loop benchmark").
+        # (speed targets live in measurements, not in timed tests; docs/results/benchmarks.md "Loop benchmark").
         code, s, err = self.tmp.run_json("step-in-place.yaml", DOMAIN_BASE + 2)
         self.assertEqual(code, 0, err[-2000:])
         plain, recorded = s["services"]["mft-sim"], self.summary["services"]["mft-sim"]
@@ -309,7 +309,7 @@ class StarvedRecorder(unittest.TestCase):
         sim_log.wait_for_sim_time(1.0)  # the recorder is recording
         # Shorter than the participant lease (1 s, config/dds_profiles.xml): a recorder stopped for longer
         # finds the other participants expired when it resumes and drops their queued samples until they
-        # announce themselves again (docs/recording.md), which no flow control can prevent. Timed at SCHED_FIFO
+        # announce themselves again (docs/guide/recording.md), which no flow control can prevent. Timed at SCHED_FIFO
         # 85: a normal-priority sleep of 0.5 s can last past the lease on a busy machine.
         with fifo_priority():
             self.stopped.append(pid)

@@ -295,7 +295,7 @@ TEST(RawlogFormat, MetadataRecordsTheDdsNamingAndOlderFilesReadAsPlain) {
   EXPECT_EQ(parsed.scenario_name, "unit");
 }
 
-// Live tuning (docs/live-tuning.md): an applied change goes through the config_change label and comes back with
+// Live tuning (docs/guide/live-tuning.md): an applied change goes through the config_change label and comes back with
 // its key and value text exactly as sent (schema 2's text channel), tick and time; the key channel still holds the
 // key's index in tunableKeys() (-1 when it is not tunable). An observation without the text (schema 1) gets key and
 // value back from that index and the numbers, and a key that is not tunable reads back empty, so mft-replay
@@ -404,7 +404,7 @@ std::string hugeVectorFile(const TempDir& dir) {
 }
 
 // Offset of the element count of `field` in the first object of class `cls` in a recorded rawlog's bytes,
-// walking the layouts MRPT 2.5.8 writes (docs/mrpt.md "What the reader checks").
+// walking the layouts MRPT 2.5.8 writes (docs/reference/mrpt.md "What the reader checks").
 std::size_t countOffset(const std::string& raw, const std::string& cls, const std::string& field) {
   const std::size_t at = raw.find(static_cast<char>(0x80 | cls.size()) + cls);
   EXPECT_NE(at, std::string::npos) << cls;

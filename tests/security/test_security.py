@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Security tests of the stack (docs/security.md): a secured stack (services/mft-supervisor --secure, material
+"""Security tests of the stack (docs/guide/security.md): a secured stack (services/mft-supervisor --secure, material
 from scripts/make-security.sh in a temporary directory) refuses participants without a valid identity and
 writers without permission, and still steps in place. Real processes, DDS domains 220-224, bounded in time,
 every process cleaned up (by pid, through the supervisor's `down`) even on failure."""
@@ -21,7 +21,7 @@ DOMAIN = 220
 # secured chain to connect (SECURE_START_TIMEOUT_S in python/mftstack/processes.py), past which Fast DDS's handshake
 # is taken as stuck. On an idle machine it takes 0.3-1.2 s.
 SECURE_MATCH_TIMEOUT_S = 10
-# Fast DDS 2.9.1's handshake between two participants sometimes never completes (docs/security.md; seen here
+# Fast DDS 2.9.1's handshake between two participants sometimes never completes (docs/guide/security.md; seen here
 # with the other core busy: a new participant of the recorder's identity matched neither the simulator's nor
 # the WBC's writer within 10 s). The supervisor then starts a new participant (SECURE_RUN_ATTEMPTS = 2), which
 # authenticates afresh; the test does the same with its listener, at most this many times, and says so.

@@ -46,7 +46,7 @@ TEST(DdsRuntime, SamplesFlowInOrderAndDeadlineMissesAreCounted) {
   EXPECT_EQ(out_of_order.load(), 0u);
   const auto misses_while_flowing = reader.requestedDeadlineMisses();
   const auto outside_while_flowing = reader.deadlineMissesOutsideStream();
-  // The writer stops: the 3 ms deadline must fire (about every 2 ms, docs/dds.md#deadline-and-liveliness-timing),
+  // The writer stops: the 3 ms deadline must fire (about every 2 ms, docs/reference/dds.md#deadline-and-liveliness-timing),
   // counted outside the stream (a stopping stack), not as the chain's misses.
   std::this_thread::sleep_for(50ms);
   const auto outside_after_stop = reader.deadlineMissesOutsideStream();
@@ -102,7 +102,7 @@ TEST(PollingReceive, BurstsArriveWholeInOrderAndInBatches) {
   SensorReader reader_b(second, "SensorData", "control_reader", counter(b));
   SensorWriter writer(sim, "SensorData", "control_writer");
   ASSERT_TRUE(waitUntil([&] { return writer.matched() == 2 && reader_a.matched() == 1 && reader_b.matched() == 1; }, 5000ms));
-  std::this_thread::sleep_for(20ms);  // samples written in the instant of matching may be lost (docs/dds.md#samples-before-matching)
+  std::this_thread::sleep_for(20ms);  // samples written in the instant of matching may be lost (docs/reference/dds.md#samples-before-matching)
 
   const std::uint64_t datagrams_before = stats.datagrams.load();
   mft::msg::SensorData m;
@@ -127,7 +127,7 @@ TEST(PollingReceive, BurstsArriveWholeInOrderAndInBatches) {
   EXPECT_GE(stats.max_datagrams_per_poll.load(), 5u);
 }
 
-// ROS 2's names on the wire (docs/interop.md#ros-2): topic rt/mft/<snake_case>, type mft::msg::dds_::<Name>_.
+// ROS 2's names on the wire (docs/guide/interop.md#ros-2): topic rt/mft/<snake_case>, type mft::msg::dds_::<Name>_.
 TEST(DdsNames, TopicNamesAreRos2Names) {
   EXPECT_EQ(ddsTopicName("SensorData"), "rt/mft/sensor_data");
   EXPECT_EQ(ddsTopicName("WbcDiagnostics"), "rt/mft/wbc_diagnostics");

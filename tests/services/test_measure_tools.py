@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The loop benchmark's tools (docs/loop-benchmark.md): mft-wakeup, the machine's wake-up floor, and
+"""The loop benchmark's tools (docs/results/loop-benchmark.md): mft-wakeup, the machine's wake-up floor, and
 scripts/measure-stack.py, the lockstep/in-process ratio with the per-hop split (one short round of the real stack,
 DDS domain 204), and their one-line errors."""
 import json

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Bad input and misuse with the real executables (issue 16; docs/faults.md "Bad input and misuse"): a busy DDS
+"""Bad input and misuse with the real executables (issue 16; docs/results/faults.md "Bad input and misuse"): a busy DDS
 domain seen by mft-participants, a broken configuration file refused by the services' --check-config before
 anything starts, mft-record refusing to replace a recording, files that are not UTF-8. The supervisor's own
 handling of the same cases is tested against fake services in test_supervisor.py. Needs MFT_BIN_DIR (set by

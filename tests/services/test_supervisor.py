@@ -398,7 +398,7 @@ class SupervisorTest(FakeStack, unittest.TestCase):
 
 
 class MisuseTest(FakeStack, unittest.TestCase):
-    """Bad input and misuse (issue 16, docs/faults.md "Bad input and misuse"): each is refused with one line
+    """Bad input and misuse (issue 16, docs/results/faults.md "Bad input and misuse"): each is refused with one line
     before anything starts, or handled without losing a result."""
 
     def sup_cmd(self, *args, realtime=False):

@@ -1,6 +1,6 @@
 #pragma once
 // Shared by the simulator tests and sim_hash_probe: config loading and the simple stance controller of
-// docs/simulation.md#standing-with-a-joint-pd (hip PD + gravity feed-forward -J' (0, W/2) per leg).
+// docs/reference/simulation.md#standing-with-a-joint-pd (hip PD + gravity feed-forward -J' (0, W/2) per leg).
 #include <string>
 
 #include "model/five_bar.hpp"
@@ -32,7 +32,7 @@ inline model::ActuatorCommand hangAndDriveRightHips(Simulator& sim, double base_
 }
 
 // Joint-space PD on the four hips around a fixed target, plus the torque that carries half the weight on
-// each foot. Kp >= 300 N m/rad is needed for this geometry (docs/simulation.md#standing-with-a-joint-pd).
+// each foot. Kp >= 300 N m/rad is needed for this geometry (docs/reference/simulation.md#standing-with-a-joint-pd).
 struct StanceController {
   model::FiveBarGeometry geometry;
   model::VectorA q_des = model::VectorA::Zero();

@@ -34,7 +34,7 @@ void swingState(const mft::model::RobotDescription& d, VectorQ* q, VectorQ* qd) 
 
 TEST(SimEnergy, PassiveSwingWithFixedTorso) {
   // A conservative spring between the two thighs of each leg (applied through ideal actuators every physics
-  // step, its energy counted) keeps each five-bar away from its singular stretch, as in docs/simulation.md#five-bar-singularity-and-energy: a hanging
+  // step, its energy counted) keeps each five-bar away from its singular stretch, as in docs/reference/simulation.md#five-bar-singularity-and-energy: a hanging
   // five-bar would otherwise fall onto its knee stops, which are deliberately lossy.
   const double k = 30.0;
   for (double period : {0.001, 0.00025}) {

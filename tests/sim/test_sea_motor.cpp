@@ -40,7 +40,7 @@ TEST(SimSeaMotor, GainsFollowFromThePhysics) {
   const SeaMotorParams p = shippedParams();
   EXPECT_NEAR(p.reflected_inertia_kgm2, 0.09, 1e-12);  // 30^2 * 1e-4
   const SeaMotorActuator sea(p, kH, shippedLimits());
-  // docs/five-bar-theory.md#robot-parameters-and-the-sea: Kp = 3.906, Kd = 0.0415 s for zeta = 1 (to its rounding).
+  // docs/reference/five-bar-theory.md#robot-parameters-and-the-sea: Kp = 3.906, Kd = 0.0415 s for zeta = 1 (to its rounding).
   EXPECT_NEAR(sea.proportionalGain(), 3.906, 0.002);
   EXPECT_NEAR(sea.derivativeGain(), 0.0415, 0.0001);
   EXPECT_EQ(sea.loopStepsPerPhysicsStep(), 10);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Run videos (`mft-export FILE --video OUT`, docs/videos.md) from a short push run recorded at test time through
+"""Run videos (`mft-export FILE --video OUT`, docs/guide/videos.md) from a short push run recorded at test time through
 the supervisor (real lockstep stack, DDS domains 6-9). The frames are decoded back with ffmpeg and checked
 from pixels: the hips and feet are discs of fixed colours centred where mft-export's kinematics put them
 (mapped to pixels with the renderer's own world-to-pixel transform, from --frame-log); the right leg has the

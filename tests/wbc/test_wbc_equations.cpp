@@ -1,6 +1,6 @@
 // Problem 1 one equation at a time (wbc/wbc_equations.hpp), each checked against a computation of its own: closed
 // forms written out here, finite differences, forward dynamics (6) solved by its Schur complement, and the QP's
-// H and g against a least-squares problem stacked here from the model. Paper numbers as published (docs/theory.md).
+// H and g against a least-squares problem stacked here from the model. Paper numbers as published (docs/reference/theory.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

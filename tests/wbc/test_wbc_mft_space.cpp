@@ -24,7 +24,7 @@ TEST(WbcMftSpace, NominalStanceIsInsideAndIndicesAreReported) {
   ASSERT_EQ(d.status, qp::QpStatus::Optimal);
   EXPECT_LT(d.mft_violation, 0.0);
   EXPECT_LT(d.slack_norm, 1e-9);
-  // docs/five-bar-theory.md#vertical-stance-numbers, vertical stance at 0.40 m: LTI 0.875, RACI* 158.2 N/sqrt(kg).
+  // docs/reference/five-bar-theory.md#vertical-stance-numbers, vertical stance at 0.40 m: LTI 0.875, RACI* 158.2 N/sqrt(kg).
   for (int leg = 0; leg < 2; ++leg) {
     EXPECT_NEAR(d.lti[leg], 0.875, 2e-3);
     EXPECT_NEAR(d.raci[leg], 158.2, 1.0);

@@ -1,6 +1,6 @@
 // update() allocates nothing once constructed (counted through the global operator new of this test binary),
 // and a sequence of varying ticks (stance changes, perturbations) solves every tick. A live change of weights
-// and gains (setTuning, docs/live-tuning.md) halfway through allocates nothing either.
+// and gains (setTuning, docs/guide/live-tuning.md) halfway through allocates nothing either.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// Live tuning, WBC side (docs/live-tuning.md): a change is judged by config/wbc.yaml's strict loader (its
+// Live tuning, WBC side (docs/guide/live-tuning.md): a change is judged by config/wbc.yaml's strict loader (its
 // messages for an unknown key or an invalid value, a refusal for a key that is not tunable), and
 // WholeBodyController::setTuning makes a running controller compute what a controller built with the changed
 // file computes.

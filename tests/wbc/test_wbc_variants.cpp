@@ -183,7 +183,7 @@ TEST(WbcVariants, SaAsksForTheStrongestCorrectionWhenTheBoundIsOutOfReach) {
 }
 
 TEST(WbcVariants, LtiOfTheNominalStanceMatchesTheTheory) {
-  // docs/five-bar-theory.md#vertical-stance-numbers: vertical stance at d = 0.40 m has LTI 0.875.
+  // docs/reference/five-bar-theory.md#vertical-stance-numbers: vertical stance at d = 0.40 m has LTI 0.875.
   test::StateSpec s;
   s.right_foot = {0.0, -0.40};
   s.left_foot = {0.0, -0.44};

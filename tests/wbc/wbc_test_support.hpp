@@ -43,7 +43,7 @@ inline double openingForDistance(double d) {
   return lo + hi;  // 2 theta
 }
 
-// Hexagon per leg in (q_rear, q_fore): the MFT band d in [d_lo, d_hi] (docs/five-bar-theory.md#vertical-stance-numbers: [0.199, 0.435] m)
+// Hexagon per leg in (q_rear, q_fore): the MFT band d in [d_lo, d_hi] (docs/reference/five-bar-theory.md#vertical-stance-numbers: [0.199, 0.435] m)
 // as two edges on the opening, cut by the hip-limit box. Unit-normal rows, 6 per leg.
 inline WbcPolytope testPolytope(double d_lo = 0.199, double d_hi = 0.435) {
   WbcPolytope p;

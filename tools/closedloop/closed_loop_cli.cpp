@@ -15,7 +15,7 @@ void declareOptions(config::CommandLine& cli) {
   cli.option("scenario", "scenario file (config/scenarios/*.yaml)");
   cli.option("config-dir", "configuration folder", config::configDirFor(MFT_CONFIG_DIR));
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, applied after the scenario's "
-             "(repeatable, in order, or a comma list; docs/profiles.md)");
+             "(repeatable, in order, or a comma list; docs/guide/profiles.md)");
   cli.option("controller", "mft | sa | none (default: the scenario's, else mft)");
   cli.option("estimator", "kalman | ground_truth (default: the scenario's, else kalman)");
   cli.option("height", "base height command and initial height [m] (default 0.42 without a scenario)");
@@ -39,7 +39,7 @@ void declareOptions(config::CommandLine& cli) {
   cli.option("trajectory", "write the full-precision trajectory (truth of tick k, command k) to this CSV file");
   cli.flag("json", "print the summary as JSON (default: a short text summary)");
   cli.option("dump-qp", "write the WBC's QP of the ticks in the dump window to this existing folder as WBCQP files "
-             "(docs/qp-instances.md)");
+             "(docs/reference/qp-instances.md)");
   cli.option("dump-from", "with --dump-qp: first tick of the window, as sim time [s]", "0.0");
   cli.option("dump-count", "with --dump-qp: number of consecutive ticks", "1");
   cli.option("dump-name", "with --dump-qp: instance name prefix; files are <prefix>_<tick>.txt", "wbc");

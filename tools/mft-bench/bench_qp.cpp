@@ -1,6 +1,6 @@
-// QP solver latency on the project's QP instance set (tests/data/qp, docs/qp-instances.md), solved in file-name
+// QP solver latency on the project's QP instance set (tests/data/qp, docs/reference/qp-instances.md), solved in file-name
 // order, one solve per benchmark iteration, only the solve() call timed (mean / p50 / p99 / max in us).
-// mft-qp bench reports the same with the per-step minimum over passes (docs/qp.md#measuring-solve-time).
+// mft-qp bench reports the same with the per-step minimum over passes (docs/reference/qp.md#measuring-solve-time).
 #include <benchmark/benchmark.h>
 
 #include <string>

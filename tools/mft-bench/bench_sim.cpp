@@ -15,7 +15,7 @@ namespace {
 
 using namespace mft;
 
-// Joint-space PD around the standing pose plus -J' (0, W/2) per leg (docs/simulation.md#standing-with-a-joint-pd).
+// Joint-space PD around the standing pose plus -J' (0, W/2) per leg (docs/reference/simulation.md#standing-with-a-joint-pd).
 model::ActuatorCommand standCommand(const model::FiveBarGeometry& g, const model::VectorA& q_des, double load,
                                     const model::SensorReadings& s) {
   model::ActuatorCommand c;

@@ -94,7 +94,7 @@ void runTicks(benchmark::State& state, wbc::WbcVariant variant) {
   wbc::WholeBodyController controller(seq.robot, config, &seq.polytope);
   wbc::WbcDiagnostics diag;
   bench::LatencyRecorder recorder;
-  // Per-state minimum over the passes (docs/qp.md#measuring-solve-time): its maximum is the worst tick without the
+  // Per-state minimum over the passes (docs/reference/qp.md#measuring-solve-time): its maximum is the worst tick without the
   // machine's interference (timer interrupts, other processes), which dominates max_us on a shared host.
   std::vector<double> min_per_state(seq.states.size(), 1e300);
   double solve_sum = 0.0, solve_max = 0.0, iterations = 0.0;

@@ -1,5 +1,5 @@
 #pragma once
-// Which of the stack's services a request of mft-cmd reached (docs/operator-commands.md, "Every reader gets it").
+// Which of the stack's services a request of mft-cmd reached (docs/guide/operator-commands.md, "Every reader gets it").
 // The services that must have it are those whose identity reads the topic in the registry (idl/topics.yaml: its
 // readers, and the recorder when it is recorded), among the participants discovered on the domain and the stack's
 // services they announce (the supervisor's --stack-services). A service got the request when each of its

@@ -1,5 +1,5 @@
 // mft-cmd: sends an operator command (height, speed, mode) or a disturbance (a sagittal push) to a running
-// stack and reports the stack's verdict (docs/operator-commands.md): it waits until a reader of the stack has
+// stack and reports the stack's verdict (docs/guide/operator-commands.md): it waits until a reader of the stack has
 // matched its writer (reliable, transient local), until every service that reads the topic (the recorder included)
 // has acknowledged the sample, and until the planner (commands) or the simulator (pushes) has answered on
 // CommandVerdict with the command's seq.
@@ -21,10 +21,10 @@ static int toolMain(int argc, char** argv) {
       "The planner answers commands, the simulator pushes: rejected (with the reason), scheduled (a push at a\n"
       "lift-off or a later time) or applied at a tick. mft-cmd waits for 'applied' (or a rejection) up to\n"
       "--verdict-timeout; a command still only scheduled then counts as accepted. Protocol:\n"
-      "docs/operator-commands.md. --set changes a tunable key of config/wbc.yaml (answered by mft-wbc) or\n"
+      "docs/guide/operator-commands.md. --set changes a tunable key of config/wbc.yaml (answered by mft-wbc) or\n"
       "config/planner.yaml (mft-planner) while the stack runs, judged by that file's strict loader; a lockstep stack\n"
       "takes it at a stated simulated time only (--at), a realtime one at the next tick without --at\n"
-      "(docs/live-tuning.md). Several --set: one change each, in order; the exit status is the worst.\n"
+      "(docs/guide/live-tuning.md). Several --set: one change each, in order; the exit status is the worst.\n"
       "Every service of the stack that reads the topic (the recorder too) must acknowledge the request within\n"
       "--timeout; those that did not are named.\n"
       "Exit status: 0 accepted (applied, or scheduled by the stack); 1 rejected by the stack (the reason is\n"

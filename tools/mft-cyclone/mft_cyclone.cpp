@@ -1,7 +1,7 @@
 // mft-cyclone: a second DDS vendor on the stack's topics. Built with Eclipse Cyclone DDS from the project's own
 // IDL (idl/mft_msgs.idl through Cyclone's idlc), it reads what the Fast DDS stack publishes and sends it an
 // OperatorCommand, so that a test can show that another implementation interoperates with ours (wire protocol,
-// type names, QoS). docs/interop.md.
+// type names, QoS). docs/guide/interop.md.
 // Its topics and their fields come from the topic registry (idl/topics.yaml, generated mft_cyclone_topics.hpp).
 #include <cmath>
 #include <cstdio>
@@ -14,7 +14,7 @@ static const char *const kUsage =
     "       mft-cyclone command --domain N --mode stand|step_in_place|walk --height Z [--speed V] [--wait S]\n"
     "                           [--topic-prefix P] [--json]\n"
     "\n"
-    "A Cyclone DDS participant on the mft-wbc topics (docs/interop.md), built from idl/mft_msgs.idl.\n"
+    "A Cyclone DDS participant on the mft-wbc topics (docs/guide/interop.md), built from idl/mft_msgs.idl.\n"
     "listen : reads --topics (default SensorData,JointCommand,Reference; any topic of idl/topics.yaml) for\n"
     "         --seconds (default 3) or until each topic has --min-samples samples; prints per topic: samples,\n"
     "         first/last tick (an event's seq), tick decreases, non-finite values, and the range of one value\n"

@@ -1,6 +1,6 @@
 // mft-export: an mft rawlog to full-precision CSV (one file per label, named columns, %.17g), a summary of
 // what a file holds (--info), paper-style figures (--plot: CSV + tools/mft-export/mft-plot.py), or a video of
-// the robot as it moved (--video: video.cpp + tools/mft-export/mft-video.py, docs/videos.md).
+// the robot as it moved (--video: video.cpp + tools/mft-export/mft-video.py, docs/guide/videos.md).
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -107,7 +107,7 @@ int exportMain(int argc, char** argv) {
   cli.option("plot", "write CSV into DIR/csv and figures (PNG) into DIR");
   cli.flag("metadata", "print the metadata comment (YAML) and exit");
   cli.flag("json", "print the summary as JSON");
-  cli.option("video", "write a video of the run to this .mp4 or .gif file (docs/videos.md)");
+  cli.option("video", "write a video of the run to this .mp4 or .gif file (docs/guide/videos.md)");
   cli.option("beside", "with --video: a second rawlog drawn beside the first, on the same clock (e.g. the other "
                        "controller's run of the same push)");
   cli.option("speed", "with --video: simulated seconds per video second (default 1: real time; 0.25 = slow motion)");

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""mft-video: the renderer behind `mft-export FILE --video OUT.mp4|.gif` (docs/videos.md).
+"""mft-video: the renderer behind `mft-export FILE --video OUT.mp4|.gif` (docs/guide/videos.md).
 
 mft-export reads the rawlog, computes every drawn point with the project's kinematics and writes JSON lines on
 this program's stdin: one header (output, ffmpeg, fps, panels with their ground profile), then one line per

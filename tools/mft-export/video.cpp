@@ -501,7 +501,7 @@ int videoMain(const services::CommandLine& cli, const std::string& file) {
   auto removeTmp = [&] { ::unlink(tmp.c_str()); };
   const std::string header = headerLine(cli, r, tmp, panels, expected_end);
 
-  // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/videos.md).
+  // The renderer: python3-matplotlib draws each frame and pipes it into ffmpeg (docs/guide/videos.md).
   std::signal(SIGPIPE, SIG_IGN);  // a renderer that died shows as a failed write, not as our death
   services::installShutdownHandlers();
   const std::string script = config::dataFileFor("scripts/mft-video.py", MFT_VIDEO_SCRIPT);

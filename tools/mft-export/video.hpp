@@ -2,7 +2,7 @@
 // mft-export FILE --video OUT.mp4|OUT.gif: a run video. This side reads the rawlog(s) as a stream, samples the
 // ground truth at each video frame's simulated time, computes every drawn point with the project's own
 // kinematics (robot_drawing.hpp) and hands one JSON line per frame to the renderer (mft-video.py:
-// matplotlib, piped into ffmpeg). Nothing is kept per frame on either side. docs/videos.md.
+// matplotlib, piped into ffmpeg). Nothing is kept per frame on either side. docs/guide/videos.md.
 #include <string>
 
 #include "services/runtime/process.hpp"

@@ -76,7 +76,7 @@ Corruption corruptionOf(const services::CommandLine& cli) {
 Options parseOptions(int argc, char** argv) {
   services::CommandLine cli(
       "mft-inject",
-      "Test participant for the security tests and the fault matrix (docs/security.md, docs/faults.md).\n"
+      "Test participant for the security tests and the fault matrix (docs/guide/security.md, docs/results/faults.md).\n"
       "  mft-inject --domain 190 --listen all --seconds 3 --json\n"
       "  mft-inject --domain 190 --secure DIR --identity cmd --publish JointCommand --value 20 --seconds 2\n"
       "  mft-inject --domain 190 --publish RobotState --follow --value nan --seconds 2 --json\n"

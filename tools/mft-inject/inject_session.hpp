@@ -1,6 +1,6 @@
 #pragma once
 // One mft-inject run: its options, the participant with its publisher and listeners, the waits and the window,
-// and the report (docs/security.md, docs/faults.md).
+// and the report (docs/guide/security.md, docs/results/faults.md).
 #include <cstdint>
 #include <map>
 #include <memory>

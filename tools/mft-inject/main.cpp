@@ -1,4 +1,4 @@
-// mft-inject: a test participant for the security tests and the fault matrix (docs/security.md, docs/faults.md).
+// mft-inject: a test participant for the security tests and the fault matrix (docs/guide/security.md, docs/results/faults.md).
 //  --listen TOPICS        joins the domain (with no identity, or --secure DIR --identity NAME), subscribes and
 //                         counts samples per topic: matched writers, received, non-finite samples, largest gap.
 //                         With --wait-writers S it first waits (at most S seconds) until every listened topic has a

@@ -1,7 +1,7 @@
 // mft-participants: which DDS participants are on a domain. Joins the domain with the project's participant
 // profile (or a stack host's profile, --profiles), listens for participant discovery for a bounded time and
 // prints what it discovered (name, GUID prefix, addresses, when), as text or --json. The supervisor runs it
-// before it starts a stack, to refuse a domain that is already in use (docs/faults.md, "Bad input and misuse").
+// before it starts a stack, to refuse a domain that is already in use (docs/results/faults.md, "Bad input and misuse").
 // Exit status: 0 (whatever it found), 2 on bad options or an unusable profile file, 3 when the participant
 // cannot be created.
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -86,7 +86,7 @@ int toolMain(int argc, char** argv) {
   cli.option("domain", "DDS domain id (0..232)", "", true);
   cli.option("profiles", "DDS QoS profile file (its participant profile mft_participant is used)",
              mft::config::dataFileFor("config/dds_profiles.xml", MFT_DDS_PROFILES));
-  cli.option("wait-ms", "how long to listen for participants [ms] (docs/faults.md: discovery on loopback took "
+  cli.option("wait-ms", "how long to listen for participants [ms] (docs/results/faults.md: discovery on loopback took "
              "92-368 ms on a loaded 2-core VM)", "1000");
   cli.flag("stop-at-first", "return as soon as one participant is discovered");
   cli.flag("json", "print JSON");

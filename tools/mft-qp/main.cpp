@@ -1,4 +1,4 @@
-// mft-qp: the project's Goldfarb–Idnani QP solver on WBCQP v1 instance files (docs/qp-instances.md#file-format).
+// mft-qp: the project's Goldfarb–Idnani QP solver on WBCQP v1 instance files (docs/reference/qp-instances.md#file-format).
 #include <cstdlib>
 #include <cstring>
 #include <iostream>

@@ -63,7 +63,7 @@ Accuracy checkSolution(const QpInstance& inst, const QpSolution& s) {
   return a;
 }
 
-// The run of an instance named <run>_<tick> (docs/qp-instances.md): the name without its last "_<suffix>".
+// The run of an instance named <run>_<tick> (docs/reference/qp-instances.md): the name without its last "_<suffix>".
 std::string runName(const std::string& name) { return name.substr(0, name.rfind('_')); }
 
 // The solver's "optimal" is reported only when its answer satisfies the KKT conditions (stationarity,
@@ -107,7 +107,7 @@ std::vector<QpInstance> loadFolder(const std::string& dir) {
   return out;
 }
 
-// Real-time hygiene as in docs/qp.md#measuring-solve-time; every step degrades gracefully and is reported.
+// Real-time hygiene as in docs/reference/qp.md#measuring-solve-time; every step degrades gracefully and is reported.
 std::string prepareProcess(int cpu) {
   std::string notes;
   mallopt(M_MMAP_MAX, 0);

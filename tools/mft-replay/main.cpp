@@ -30,7 +30,7 @@ void defineOptions(services::CommandLine& cli) {
   cli.option("tolerance", "--through-wbc: largest accepted |tau - tau_recorded| [N m]", "1e-9");
   cli.option("wbc-config", "--through-wbc: use this wbc.yaml instead of the recorded one (to test a change)");
   cli.flag("ignore-live-changes", "--through-wbc: do not apply the WBC changes recorded from mft-cmd --set "
-           "(docs/live-tuning.md); by default each acts from its recorded tick");
+           "(docs/guide/live-tuning.md); by default each acts from its recorded tick");
   cli.flag("json", "print the result as JSON");
 }
 

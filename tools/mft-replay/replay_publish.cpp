@@ -88,7 +88,7 @@ struct Item {
   std::int64_t rel_ns;  // since the first message played
 };
 
-// A read-ahead thread keeps file I/O and decoding off the pacing thread (docs/mrpt.md#write-stalls-and-flushing: I/O hiccups).
+// A read-ahead thread keeps file I/O and decoding off the pacing thread (docs/reference/mrpt.md#write-stalls-and-flushing: I/O hiccups).
 class ReadAhead {
  public:
   ReadAhead(rawlog::RawlogReader& reader, const std::set<rawlog::Topic>& topics, double start_s, double duration_s)

@@ -23,7 +23,7 @@ namespace mft::replay {
 
 namespace {
 
-// The WBC changes applied while the run was recorded (live tuning, docs/live-tuning.md): a first pass over the
+// The WBC changes applied while the run was recorded (live tuning, docs/guide/live-tuning.md): a first pass over the
 // file collects the applied ConfigChange records of mft-wbc (written some ticks after the tick they act from), and
 // each becomes the controller's weights and gains from its tick on, judged by the same strict loader as live.
 struct RecordedChange {

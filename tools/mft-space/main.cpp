@@ -1,4 +1,4 @@
-// mft-space: the offline MFT preferable space of the five-bar legs (paper sec. III-B, docs/five-bar-theory.md#the-polygon-fit).
+// mft-space: the offline MFT preferable space of the five-bar legs (paper sec. III-B, docs/reference/five-bar-theory.md#the-polygon-fit).
 // Exit codes: 0 done, 1 the work failed (fit, file output, figure on `figure`), 2 bad arguments or bad config.
 #include <iostream>
 #include <string>

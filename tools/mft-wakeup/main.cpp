@@ -1,5 +1,5 @@
 // mft-wakeup: how fast this machine wakes a thread, the floor under every hop of the chain
-// (docs/loop-benchmark.md). Two probes, each thread pinned to one CPU:
+// (docs/results/loop-benchmark.md). Two probes, each thread pinned to one CPU:
 //  timer:   a thread sleeps to absolute 1 kHz deadlines (clock_nanosleep, as mft-sim's realtime pacer) on each
 //           CPU in turn; lateness = wake-up time - deadline (cyclictest's measure);
 //  wake-up: two threads hand a token back and forth through a futex; one-way latency = from the waker's
@@ -32,7 +32,7 @@ void writeStats(mft::config::JsonWriter& w, const char* key, const Stats& s) {
 int toolMain(int argc, char** argv) {
   mft::config::CommandLine cli("mft-wakeup",
                                "The machine's own wake-up latency: 1 kHz timer lateness per CPU and thread-to-thread\n"
-                               "wake-ups on one core and across cores (cyclictest-like; docs/loop-benchmark.md).");
+                               "wake-ups on one core and across cores (cyclictest-like; docs/results/loop-benchmark.md).");
   cli.option("timer-samples", "1 kHz timer wake-ups per CPU", "2000");
   cli.option("wakeups", "token hand-offs per placement (one core, two cores)", "5000");
   cli.flag("rt", "run the probe threads SCHED_FIFO 80 (as the realtime stack's --rt), when permitted");

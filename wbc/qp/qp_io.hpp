@@ -1,5 +1,5 @@
 #pragma once
-// Reader and writer of the WBCQP v1 text format (docs/qp-instances.md#file-format). Numbers are written with %.17g, so a
+// Reader and writer of the WBCQP v1 text format (docs/reference/qp-instances.md#file-format). Numbers are written with %.17g, so a
 // write/read round trip is bit-exact; inf / -inf are accepted. Malformed input (unknown record, wrong size, bad
 // number, missing record, duplicate, text after "end") throws QpIoError whose message names the file.
 #include <optional>
@@ -27,7 +27,7 @@ struct QpInstance {
   std::vector<QpBlock> varblocks, rowblocks;
   std::optional<Eigen::VectorXd> x_ref;
   std::optional<double> f_ref;
-  std::optional<Eigen::VectorXi> active_ref;  // length n + nin, docs/qp-instances.md#file-format convention
+  std::optional<Eigen::VectorXi> active_ref;  // length n + nin, docs/reference/qp-instances.md#file-format convention
 };
 
 // Reading refuses, besides malformed text: a directory or other non-regular file, a file over kMaxFileBytes,

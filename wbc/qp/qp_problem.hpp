@@ -38,7 +38,7 @@ struct QpSolution {
   double objective = 0.0;
   int iterations = 0;       // working-set changes (additions + removals)
   // Active set at the solution, length n + nin: +1 active at upper, -1 at lower, 0 inactive
-  // (the convention of docs/qp-instances.md#file-format, active_ref). Equalities are always active and not listed.
+  // (the convention of docs/reference/qp-instances.md#file-format, active_ref). Equalities are always active and not listed.
   Eigen::VectorXi active;
   // Lagrange multipliers: equalities (neq), bounds (n) and rows (nin), signed so that
   //   H x + g = Aeq' y_eq + y_bounds + Ain' y_rows,

@@ -1,5 +1,5 @@
 #pragma once
-// Dense Goldfarb–Idnani dual active-set solver for QpProblem (docs/qp.md).
+// Dense Goldfarb–Idnani dual active-set solver for QpProblem (docs/reference/qp.md).
 //
 // Method: H = L L', J = L^-T. Start at the unconstrained minimizer x0 = -J J' g, add the equalities (always
 // active), then repeatedly add the most violated inequality, taking primal/dual steps that keep every active

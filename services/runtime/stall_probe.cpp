@@ -3,6 +3,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <time.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -15,12 +16,15 @@ std::int64_t steadyNs() {
 }
 }  // namespace
 
+// Every online CPU, not only this process's: a realtime stack pins its chain (and so the simulator) to one core,
+// and a stall of the other core still delays the services placed there. A CPU this thread may not run on (a
+// cpuset) is left out: its thread ends at once and is not counted.
 StallProbe::StallProbe(const Options& options) : options_(options), ring_(std::max<std::size_t>(options.capacity, 1)) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof set, &set) != 0) return;
-  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
-    if (CPU_ISSET(cpu, &set)) threads_.emplace_back([this, cpu] { run(cpu); });
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  for (int cpu = 0; cpu < std::min<long>(online, CPU_SETSIZE); ++cpu) threads_.emplace_back([this, cpu] { run(cpu); });
+  // cpus() is final once every thread has tried its CPU (a start-up matter of microseconds; bounded anyway).
+  for (int i = 0; i < 20000 && started_.load() < static_cast<int>(threads_.size()); ++i)
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
 }
 
 StallProbe::~StallProbe() {
@@ -32,7 +36,10 @@ void StallProbe::run(int cpu) {
   cpu_set_t one;
   CPU_ZERO(&one);
   CPU_SET(cpu, &one);
-  pthread_setaffinity_np(pthread_self(), sizeof one, &one);
+  const bool pinned = pthread_setaffinity_np(pthread_self(), sizeof one, &one) == 0;
+  if (pinned) ++probing_;
+  ++started_;
+  if (!pinned) return;
   sched_param param{};
   param.sched_priority = sched_get_priority_max(SCHED_FIFO);
   if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) != 0) {

@@ -42,7 +42,7 @@ class StallProbe {
   std::vector<std::pair<std::int64_t, std::int64_t>> stallWindows() const;
   double maxStallMs() const;
   double totalStallMs() const;
-  int cpus() const { return static_cast<int>(threads_.size()); }
+  int cpus() const { return probing_.load(); }  // the CPUs a probe thread runs on
   bool realtimePriority() const { return realtime_priority_; }
 
   // For tests: record a stall as a probe thread would.
@@ -58,6 +58,8 @@ class StallProbe {
   std::uint64_t stalls_ = 0;
   std::int64_t max_stall_ns_ = 0, total_stall_ns_ = 0;
   std::atomic<bool> stop_{false};
+  std::atomic<int> probing_{0};  // probe threads pinned to their CPU
+  std::atomic<int> started_{0};  // probe threads that tried their CPU
   bool realtime_priority_ = true;
   std::vector<std::thread> threads_;
 };

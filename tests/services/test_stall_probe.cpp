@@ -58,12 +58,28 @@ TEST(StallProbe, KeepsTheNewestStallsWhenFull) {
   EXPECT_EQ(probe.stalls(), 6u);                      // but counted
 }
 
-TEST(StallProbe, OneThreadPerCpuOfTheProcess) {
+TEST(StallProbe, OneThreadPerCpuOfTheMachineEvenWhenThisThreadIsPinned) {
   cpu_set_t set;
   CPU_ZERO(&set);
   ASSERT_EQ(sched_getaffinity(0, sizeof set, &set), 0);
-  StallProbe probe(idleProbe());
-  EXPECT_EQ(probe.cpus(), CPU_COUNT(&set));
+  {
+    StallProbe probe(idleProbe());
+    EXPECT_EQ(probe.cpus(), CPU_COUNT(&set));
+  }
+  // A realtime stack pins the simulator to the chain's core; its probe still watches every CPU.
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set)) {
+      CPU_SET(cpu, &one);
+      break;
+    }
+  ASSERT_EQ(sched_setaffinity(0, sizeof one, &one), 0);
+  {
+    StallProbe probe(idleProbe());
+    EXPECT_EQ(probe.cpus(), CPU_COUNT(&set));
+  }
+  ASSERT_EQ(sched_setaffinity(0, sizeof set, &set), 0);
 }
 
 // A child runs a probe (1 ms period, 5 ms threshold) and is stopped for 40 ms: every CPU's thread wakes at

@@ -92,13 +92,21 @@ def remove_orphan_segments(shm_dir="/dev/shm"):
 
 
 def _pid_alive(pid):
+    """True while pid runs; a zombie (killed, not yet reaped by its parent) counts as gone."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
     except OSError:
         return True
-    return True
+    return not _is_zombie(pid)
+
+
+def _is_zombie(pid):
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "Z"
+    except (OSError, IndexError):
+        return False
 
 
 def shm_problem(shm_dir="/dev/shm"):
@@ -527,6 +535,6 @@ def pid_alive(pid):
         return False
     try:
         os.kill(int(pid), 0)
-        return True
+        return not _is_zombie(int(pid))
     except (ProcessLookupError, PermissionError, ValueError):
         return False

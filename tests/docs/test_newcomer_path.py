@@ -18,6 +18,8 @@ import sys
 import tempfile
 import unittest
 
+from readme_tables import readme_table_ii
+
 ARGS = None
 DOMAIN = 163
 STEP = re.compile(r"<!-- newcomer-step: ([\w-]+) -->\s*```sh\n(.*?)```", re.S)
@@ -27,16 +29,6 @@ HEIGHT, CONTROLLER, GRID_NS = 0.44, "mft", 0.5
 def page_steps(source):
     text = (source / "docs" / "guide" / "getting-started.md").read_text()
     return [(name, body.replace("\\\n", " ")) for name, body in STEP.findall(text)]
-
-
-def readme_table_ii(source, height):
-    """The README's Table II: I_max of SA-WBC and MFT-WBC at `height`."""
-    text = (source / "README.md").read_text()
-    heights = re.search(r"\| z_B\^ref \[m\] \|(.*)\|", text).group(1).split("|")
-    values = re.search(r"\| I_max SA-WBC / MFT-WBC \[N s\] \|(.*)\|", text).group(1).split("|")
-    column = [float(h) for h in heights].index(height)
-    sa, mft = (float(v) for v in values[column].split("/"))
-    return {"sa": sa, "mft": mft}
 
 
 def ablation_slack_row(source, slack):
@@ -87,7 +79,7 @@ class NewcomerPath(unittest.TestCase):
         # The README's number lies between the last recovery and the first failure on the coarser grid.
         self.run_step("paper-cell")
         paper = self.cell("cell-paper")
-        readme = readme_table_ii(self.source, HEIGHT)[CONTROLLER]
+        readme = readme_table_ii(self.source)[HEIGHT][CONTROLLER]
         self.assertLessEqual(paper["i_max_Ns"], readme + 1e-9, paper)
         self.assertLess(readme, paper["failed_Ns"], paper)
 

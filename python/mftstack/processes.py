@@ -142,7 +142,7 @@ def chain_shm_name(args, multi_host):
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
 
-# --rt-priorities chain (the default): SCHED_FIFO priorities rising along the chain from the estimator to the
+# --rt-priorities chain (the default without --secure): SCHED_FIFO priorities rising along the chain from the estimator to the
 # simulator, which consumes the chain's end product (the command). With the chain on one core each hand-off
 # (estimator -> planner -> wbc) preempts the writer at once, and the WBC's command preempts the WBC itself: the
 # simulator has it before the writers' post-write work runs. "flat" runs them all at 80. Measured
@@ -151,13 +151,24 @@ def chain_shm_name(args, multi_host):
 RT_CHAIN_PRIORITIES = {"mft-estimator": 76, "mft-planner": 77, "mft-wbc": 78, "mft-sim": 79}
 
 
+def rt_priorities_for(args):
+    """--rt-priorities as given, else "chain", except "flat" for a --secure stack. Measured on a 2-vCPU VM
+    (docs/results/loop-benchmark.md, "Secured stacks"): a secured standing stack in realtime fell in 4 of 9 runs of
+    20-90 s with the chain's priorities (its chain rides secured DDS: it missed most deadlines, or the estimator's
+    input stopped for good) and in none of 7 with flat ones; plain DDS with the chain's priorities in none of 7."""
+    given = getattr(args, "rt_priorities", None)
+    if given:
+        return given
+    return "flat" if getattr(args, "secure", None) else "chain"
+
+
 def realtime_options(name, args):
     """The options of service `name` for the realtime knobs: --rt-priority with --rt-priorities chain, mft-sim's
     --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
     if args.mode != "realtime" or getattr(args, "no_rt", False):
         return []
     extra = []
-    if getattr(args, "rt_priorities", "chain") == "chain" and name in RT_CHAIN_PRIORITIES:
+    if rt_priorities_for(args) == "chain" and name in RT_CHAIN_PRIORITIES:
         extra += ["--rt-priority", str(RT_CHAIN_PRIORITIES[name])]
     if name == "mft-sim" and getattr(args, "sim_spin_us", 0):
         extra += ["--spin-us", str(args.sim_spin_us)]

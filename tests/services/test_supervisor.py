@@ -116,6 +116,15 @@ class RealtimeKnobsTest(unittest.TestCase):
         self.assertEqual(realtime_options("mft-record", args), [])
         self.assertEqual(realtime_options("mft-wbc", self.args(rt_priorities="flat")), [])
 
+    def test_a_secured_stack_runs_flat_unless_told(self):
+        chain = ["mft-estimator", "mft-planner", "mft-wbc", "mft-sim"]
+        secured = self.args(rt_priorities=None, secure="/keys")
+        self.assertEqual([realtime_options(n, secured) for n in chain], [[]] * 4)  # all at the services' 80
+        plain = self.args(rt_priorities=None)
+        self.assertEqual([realtime_options(n, plain)[1] for n in chain], ["76", "77", "78", "79"])
+        told = self.args(rt_priorities="chain", secure="/keys")
+        self.assertEqual(realtime_options("mft-sim", told), ["--rt-priority", "79"])
+
     def test_spin_goes_to_the_simulator_alone_and_nothing_in_lockstep(self):
         flat = dict(rt_priorities="flat")
         self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150, **flat)), ["--spin-us", "150"])

@@ -7,14 +7,17 @@ set -u
 
 usage() {
   cat <<'EOF'
-usage: scripts/repeat-tests.sh NAME COUNT [--busy-core] [--cpu N] [--build-dir DIR] [--log-dir DIR] [--results FILE]
+usage: scripts/repeat-tests.sh NAME COUNT [--busy-core | --busy-all] [--cpu N] [--build-dir DIR] [--log-dir DIR]
+                               [--results FILE]
 
 Runs the CTest test NAME (exact name, e.g. security_stack) up to COUNT times, stopping at the first failure.
 Each run: unshare -n sh -c 'ip link set lo up; ctest --test-dir DIR -R "^NAME$" --output-on-failure'
 (a private network namespace: DDS domains of other users never collide). Needs root (unshare -n).
 
   --busy-core      keep one CPU busy with a shell busy loop pinned to it (taskset) for the whole series
-  --cpu N          the CPU to keep busy (default: the last one)
+  --busy-all       keep every CPU this script may use busy, one busy loop pinned to each (another job loading
+                   both cores of a 2-core machine)
+  --cpu N          the CPU to keep busy with --busy-core (default: the last one)
   --build-dir DIR  the CTest build folder (default: build/release)
   --log-dir DIR    where the output of every run is kept, run-N.log (default: a new folder under /tmp)
   --results FILE   append one tab-separated line: date, name, busy, runs, passes, first failure,
@@ -40,6 +43,7 @@ results=
 while [ $# -gt 0 ]; do
   case "$1" in
     --busy-core) busy=1 ;;
+    --busy-all) busy=all ;;
     --cpu) [ $# -ge 2 ] || die "--cpu needs a CPU number"; cpu=$2; shift ;;
     --build-dir) [ $# -ge 2 ] || die "--build-dir needs a folder"; build_dir=$2; shift ;;
     --log-dir) [ $# -ge 2 ] || die "--log-dir needs a folder"; log_dir=$2; shift ;;
@@ -58,21 +62,25 @@ listed=$(ctest --test-dir "$build_dir" -N -R "^${name}\$" 2>/dev/null | grep -c 
 [ -n "$log_dir" ] || log_dir=$(mktemp -d "/tmp/repeat-${name}-XXXXXX")
 mkdir -p "$log_dir" || die "cannot create $log_dir"
 
-busy_pid=
+busy_pids=()
 stop_busy() {
-  if [ -n "$busy_pid" ]; then
-    kill "$busy_pid" 2>/dev/null
-    wait "$busy_pid" 2>/dev/null
-    busy_pid=
-  fi
+  for pid in "${busy_pids[@]}"; do
+    kill "$pid" 2>/dev/null
+    wait "$pid" 2>/dev/null
+  done
+  busy_pids=()
 }
 trap 'stop_busy; exit 130' INT TERM
 trap stop_busy EXIT
-if [ "$busy" = 1 ]; then
-  taskset -c "$cpu" sh -c 'while :; do :; done' &
-  busy_pid=$!
-  echo "busy loop pid $busy_pid on CPU $cpu"
-fi
+busy_cpus=
+[ "$busy" = 1 ] && busy_cpus=$cpu
+[ "$busy" = all ] && busy_cpus=$(taskset -cp $$ | sed 's/.*: //' | tr ',' '\n' |
+  awk -F- '{ if (NF == 2) for (c = $1; c <= $2; c++) print c; else print $1 }' | tr '\n' ' ')
+for c in $busy_cpus; do
+  taskset -c "$c" sh -c 'while :; do :; done' &
+  busy_pids+=($!)
+  echo "busy loop pid $! on CPU $c"
+done
 
 load1() { cut -d' ' -f1 /proc/loadavg; }
 load_start=$(load1)
@@ -102,7 +110,7 @@ runs=${#durations[@]}
 stats=$(printf '%s\n' "${durations[@]}" | sort -n | awk '{ v[NR] = $1 } END { printf "%s\t%s\t%s", v[1], v[int((NR + 1) / 2)], v[NR] }')
 load_end=$(load1)
 busy_text=no
-[ "$busy" = 1 ] && busy_text="CPU $cpu"
+[ -n "$busy_cpus" ] && busy_text="CPU $(echo $busy_cpus | tr ' ' ',')"
 echo "$name: $passes of $runs runs passed (busy core: $busy_text); duration min/median/max $(echo "$stats" | tr '\t' '/') s;" \
      "load average at start $load_start, at end $load_end"
 if [ -n "$results" ]; then

@@ -385,7 +385,8 @@ def cmd_push_sweep(args):
                                     sweep.grid, dict(asdict(setup), profiles=sweep.variants["default"].profiles),
                                     wall, (load0, load_text()))
     png = report.plot_sweep(args.out, table, args.direction)
-    summary = report.summary_json(table, sweep.results, sweep.grid, asdict(setup), wall, sweep.new_runs)
+    summary = report.summary_json(table, sweep.results, sweep.grid,
+                                  dict(asdict(setup), profiles=sweep.variants["default"].profiles), wall, sweep.new_runs)
     summary.update({"progress": sweep.progress.snapshot(), "executor": sweep.executor.info(),
                     "load_average": [load0, load_text()], "out": args.out, "table_md": str(Path(args.out) / "table.md"),
                     "table_csv": str(Path(args.out) / "table.csv"), "plot": str(png)})

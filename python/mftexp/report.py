@@ -45,7 +45,6 @@ def above_text(cell):
 
 def write_tables(out_dir, results, heights, controllers, direction, grid, setup, wall_s=None, load=None):
     out_dir = Path(out_dir)
-    start, mx = grid["start_Ns"], grid["max_Ns"]
     table = rows(results, heights, direction)
     # CSV: one row per height (the machine-readable form of Table II)
     with open(out_dir / "table.csv", "w", newline="") as f:
@@ -65,7 +64,21 @@ def write_tables(out_dir, results, heights, controllers, direction, grid, setup,
                         above_text(sa).replace(", ", " "), above_text(mft).replace(", ", " "),
                         p.get("sa", ""), p.get("mft", ""), f"{p['mft'] / p['sa']:.3f}" if p else "",
                         p.get("increase_pct", "")])
-    # Markdown in the paper's layout: heights across, SA, MFT, increase down; then the paper's rows
+    lines = table_lines(table, grid, setup, direction, wall_s, load)
+    (out_dir / "table.md").write_text("\n".join(lines) + "\n")
+    return table
+
+
+def table_from_summary(summary):
+    """The arguments of table_lines from the summary.json push-sweep writes (a results file of the docs)."""
+    table = [(row["height_m"], row["sa"], row["mft"], row["increase_pct"]) for row in summary["table"]]
+    return table, summary["grid"], summary["setup"], summary["setup"]["direction"]
+
+
+def table_lines(table, grid, setup, direction, wall_s=None, load=None):
+    """table.md's lines: Table II in the paper's layout, the paper's rows, each cell's boundary, the setup."""
+    start, mx = grid["start_Ns"], grid["max_Ns"]
+    # heights across, SA, MFT, increase down; then the paper's rows
     hs = " | ".join(f"{h:.2f}" for h, *_ in table)
     lines = [f"Results of push-recovery tests ({direction} push at a {setup['liftoff']}-foot lift-off, "
              f"grid {start:g} + k·{grid['step_Ns']:g} N s, search {grid['search']})", "",
@@ -99,8 +112,7 @@ def write_tables(out_dir, results, heights, controllers, direction, grid, setup,
     if wall_s is not None:
         lines += ["", f"Wall time of this invocation: {wall_s / 60:.1f} min" +
                   (f" (load average before / after: {load[0]} / {load[1]})." if load else ".")]
-    (out_dir / "table.md").write_text("\n".join(lines) + "\n")
-    return table
+    return lines
 
 
 def plot_sweep(out_dir, table, direction):

@@ -88,8 +88,10 @@ class MisuseStackTest(StackTestCase):
         self.assertTrue((Path("/dev/shm") / segments[0]).exists())  # nobody left to remove it ...
         r = self.sup("run", SCENARIOS / "stand.yaml", "--domain", domain + 1, "--run-dir", self.tmp / "next")
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertIn(f"removed /dev/shm/{segments[0]}: its supervisor is gone", r.stderr)
-        self.assertFalse((Path("/dev/shm") / segments[0]).exists())  # ... until the next start
+        # ... until the next start, this one or any other supervisor's on the machine (/dev/shm is shared: in a
+        # busy-core series beside a push sweep, the sweep's next stack removed it first, and this start had
+        # nothing left to name).
+        self.assertFalse((Path("/dev/shm") / segments[0]).exists(), r.stderr)
 
     def test_the_chain_channel_refuses_secure_and_bad_names_and_leaves_nothing_in_dev_shm(self):
         base = [str(BIN / "mft-estimator"), "--domain", str(DOMAIN_BASE + 2), "--scenario", str(SCENARIOS / "stand.yaml")]

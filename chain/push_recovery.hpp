@@ -1,5 +1,5 @@
 #pragma once
-// The one push-recovery criterion of the project (docs/results/experiments.md, "Recovered"). mft-sim (and through it
+// The one push-recovery criterion of the project (docs/guide/experiments.md, "Recovered"). mft-sim (and through it
 // the stack sweep, `mft-experiment case`/`terrain`, scripts) and mft-closedloop both feed a RecoveryWindow
 // every control tick and report judgeRecovery()'s verdict in their JSON summaries; nobody re-implements it.
 //

@@ -24,7 +24,7 @@ DESCRIPTION = """mft-experiment: the paper's experiments (section IV) on the rea
               default: I_50 / I_90, I_max per phase, outcomes by cause; table.md, heatmaps.png, probability.png
   ablation    Table II with each departure from the paper's setup (a profile, the recovery rule) toggled alone,
               and I_max against the slack weight: ablation.md/.csv/.png
-  worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/results/experiments.md)
+  worker      a Dask worker for push-sweep/ablation --scheduler on several machines (docs/guide/cluster-studies.md)
 
 Every subcommand has --help. Progress goes to stderr; errors are one line (exit status 2); Ctrl-C or SIGTERM
 keeps what finished (exit status 130) and stops every stack this tool started."""
@@ -110,7 +110,7 @@ def add_common(p, workers=True):
 
 
 def add_distributed(p):
-    g = p.add_argument_group("several machines (Dask distributed; docs/results/experiments.md#several-machines)")
+    g = p.add_argument_group("several machines (Dask distributed; docs/guide/cluster-studies.md)")
     g.add_argument("--scheduler", metavar="ADDRESS",
                    help="run every stack run as a task on the workers of this Dask scheduler (tcp://HOST:8786) "
                         "instead of --workers stacks here; results.jsonl, the table and resuming are the same")
@@ -230,7 +230,7 @@ def add_terrain_command(sub):
     t.add_argument("--out", help="output folder (default runs/terrain-<time>)")
     t.add_argument("--paper-setup", action="store_true",
                    help="without the profile kv-0.145 that the scenario otherwise carries (with the paper's k_v = 0.16 "
-                        "the robot stalls on the slope; docs/results/experiments.md#terrain-fig-8)")
+                        "the robot stalls on the slope; docs/results/terrain.md)")
     add_common(t)
     _video.add_video_options(t)
 
@@ -279,7 +279,7 @@ def add_ablation_command(sub):
 
 def add_worker_command(sub):
     """worker: a Dask worker with this clone's build."""
-    w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/results/experiments.md)",
+    w = sub.add_parser("worker", help="a Dask worker for --scheduler (this clone's build; docs/guide/cluster-studies.md)",
                        description="Starts dask-worker for SCHEDULER with this clone's mft-experiment importable and "
                                    "its services (--bin-dir) as the binaries of every run; runs until stopped "
                                    "(Ctrl-C). Equivalent by hand: PYTHONPATH=REPO/python "

@@ -1,5 +1,5 @@
 """Where a study's stack runs happen: on this machine (LocalExecutor, the default: no daemon) or on Dask
-distributed workers (DaskExecutor, --scheduler tcp://HOST:8786; docs/results/experiments.md#several-machines).
+distributed workers (DaskExecutor, --scheduler tcp://HOST:8786; docs/guide/cluster-studies.md).
 
 A run is a task: a plain dict (RunTask) with the scenario, the profiles, the configuration files, the build it
 was meant for and whether to record. `execute` is the one implementation of a run on both backends. A study
@@ -163,7 +163,7 @@ class DaskExecutor:
             self.client = self.distributed.Client(address, timeout=connect_timeout_s, set_as_default=False)
         except (OSError, TimeoutError) as e:
             raise ExperimentError(f"no Dask scheduler answers at {address} within {connect_timeout_s:.0f} s ({e}); "
-                                  f"start one with dask-scheduler (docs/results/experiments.md#several-machines)")
+                                  f"start one with dask-scheduler (docs/guide/cluster-studies.md)")
         try:
             self.client.wait_for_workers(1, timeout=worker_wait_s)
         except (TimeoutError, self.distributed.TimeoutError, OSError):

@@ -8,7 +8,7 @@ from .common import CONTROLLER_NAMES, pyplot, write_report
 from .wilson import bootstrap, crossing, curve, wilson
 
 # The paper's Table II (I_max [N s], push at the right lift-off, forward) and this project's on the stack with
-# the paper's grid (docs/results/experiments.md, push sweep with the paper's setup).
+# the paper's grid (docs/results/table-ii.md, Table II with the paper's setup).
 PAPER_TABLE2 = {"sa": {0.38: 10.4, 0.40: 9.7, 0.42: 9.1, 0.44: 7.0, 0.46: 4.5},
                 "mft": {0.38: 10.7, 0.40: 10.6, 0.42: 10.6, 0.44: 9.5, 0.46: 6.6}}
 STACK_TABLE2 = {"sa": {0.38: 12.7, 0.40: 14.5, 0.42: 11.1, 0.44: 9.4, 0.46: 8.0},

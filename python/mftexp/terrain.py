@@ -15,7 +15,7 @@ from .case import COLORS, controller_runs, run_pair
 from .mft_space import leg_polygon, mft_violations
 
 INSIDE_TOL_RAD = 0.01  # "stayed inside" allows the soft constraint's small predicted violations
-# The minimal departure from the paper's setup that the course needs (docs/results/experiments.md#terrain-fig-8): with the
+# The minimal departure from the paper's setup that the course needs (docs/results/terrain.md): with the
 # paper's k_v = 0.16 the robot stalls at the foot of the 6 degree slope and falls back (course without the board,
 # 0.20/0.25/0.30 m/s); kv-0.145 (k_v = 1/sigma1 of the LIP orbit) climbs it. It does not help at the board's edge.
 COURSE_PROFILES = ["kv-0.145"]

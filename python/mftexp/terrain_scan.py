@@ -1,7 +1,7 @@
 """terrain-scan: how often blind walking gets over the course, over the gait's phase at the board.
 
 A blind walk meets the board's leading edge wherever the gait puts its footfalls: a foot that lands in the last
-2-3 cm before the 3 cm board brings its fore shank onto the corner (docs/results/experiments.md#terrain-fig-8). Where the
+2-3 cm before the 3 cm board brings its fore shank onto the corner (docs/results/terrain.md). Where the
 footfalls fall at the edge is set by the gait's phase there, and so by how far the course starts from the robot.
 One run of `terrain` is therefore one draw. This command walks the whole course in process (mft-closedloop, the
 same configs, profiles and fall criteria as the stack) with the course shifted by each offset

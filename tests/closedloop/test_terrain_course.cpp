@@ -1,5 +1,5 @@
 // Blind walking over the paper's course (config/terrain/course.yaml) in process, MFT-WBC, Kalman estimator, the
-// command of `mft-experiment terrain` (0.42 m, 0.25 m/s). What is measured and why (docs/results/experiments.md#terrain-fig-8):
+// command of `mft-experiment terrain` (0.42 m, 0.25 m/s). What is measured and why (docs/results/terrain.md):
 // - the 3 cm board's leading edge stops the robot whenever the blind footfall before it lands within about
 //   3 cm of the edge (that leg's fore shank touches the edge), for the paper's setup and every profile set
 //   tried, at most speeds: a matter of the gait's phase at x = 1.0 m and the leg's geometry, not of the
@@ -90,7 +90,7 @@ TEST(TerrainCourseWithoutBoard, Kv0145ClimbsTheSlopeAndCrossesTheRoughGround) {
 
 // The paper's setup (no profile) never gets to the top of the slope: the reason the course needs kv-0.145.
 // Measured: stalls at the slope's foot (x 2.6 m) and falls there (0.20, 0.25, 0.30 m/s). If this starts to
-// fail, the default climbs: update docs/results/experiments.md and drop the profile from the terrain experiment.
+// fail, the default climbs: update docs/results/terrain.md and drop the profile from the terrain experiment.
 TEST(TerrainCourseWithoutBoard, PaperSetupStallsOnTheUpSlope) {
   const sim::Terrain t = courseWithoutBoard();
   const sim::TerrainSegment& slope = segmentOf(t, sim::SegmentType::Slope);
@@ -101,7 +101,7 @@ TEST(TerrainCourseWithoutBoard, PaperSetupStallsOnTheUpSlope) {
 }
 
 // The whole course (board included), the command of `mft-experiment terrain` with kv-0.145: the blind walk ends at
-// the board's leading edge, and the cause is pinned down here (docs/results/experiments.md#under-the-papers-setup-issue-15-
+// the board's leading edge, and the cause is pinned down here (docs/results/terrain.md#under-the-papers-setup-what-stops-it
 // what-stops-it). The first terrain contact of a non-foot body is a FORE shank's capsule on the board's leading
 // corner (x = 1.0 m, top 3 cm minus the 5 mm foot sphere the solids are lowered by), while that leg's ankle is
 // still on the floor side of the edge, 0-3 cm before it: the fore shank leans 20-26 degrees forward from the

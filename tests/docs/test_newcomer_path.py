@@ -5,7 +5,7 @@ The test takes the command blocks marked `<!-- newcomer-step: NAME -->` from the
 written, in a scratch folder laid out like the repository (a copy of config/, the services and the built
 programs linked in, an empty runs/); only the DDS domain is changed to the test's own. Then it checks what they
 wrote against the numbers the pages quote: the README's Table II cell, and the ablation's slack-weight row of
-docs/results/experiments.md.
+docs/results/table-ii.md.
 """
 import argparse
 import json
@@ -32,8 +32,8 @@ def page_steps(source):
 
 
 def ablation_slack_row(source, slack):
-    """docs/results/experiments.md's slack-weight table: I_max of MFT-WBC at 0.44 m for that slack weight."""
-    text = (source / "docs" / "results" / "experiments.md").read_text()
+    """docs/results/table-ii.md's slack-weight table: I_max of MFT-WBC at 0.44 m for that slack weight."""
+    text = (source / "docs" / "results" / "table-ii.md").read_text()
     row = re.search(r"^\| %d \| ([\d.]+) \| ([\d.]+) \|" % slack, text, re.M)
     return float(row.group(2))
 

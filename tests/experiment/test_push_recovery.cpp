@@ -1,4 +1,4 @@
-// The one push-recovery criterion (chain/push_recovery.hpp, docs/results/experiments.md "Recovered") on small
+// The one push-recovery criterion (chain/push_recovery.hpp, docs/guide/experiments.md "Recovered") on small
 // synthetic runs: recovered, fell, still drifting, and the cases at the edge of each band.
 #include <gtest/gtest.h>
 

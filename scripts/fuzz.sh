@@ -3,7 +3,7 @@
 # runs it for SECONDS over its seed inputs (fuzz/corpus/TARGET) and a work corpus that keeps every new interesting
 # input (build/fuzz/corpus/TARGET). A crash, hang, leak or undefined behaviour stops the run; the input is written
 # under build/fuzz/crashes/TARGET/ (printed). The normal build needs no clang: it only replays the seeds
-# (ctest -L fuzz). docs/results/faults.md#fuzzing.
+# (ctest -L fuzz). docs/results/fuzzing.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Loop benchmark of the multi-process stack (docs/results/loop-benchmark.md, docs/results/benchmarks.md "Loop benchmark").
+"""Loop benchmark of the multi-process stack (docs/results/loop-benchmark.md).
 
 Runs rounds of the same scenario (10 s step in place), each round interleaved so that a shared machine's load
 hits every measurement alike:

@@ -218,7 +218,7 @@ class RecordedLockstepRun(unittest.TestCase):
     def test_7_recording_leaves_the_lockstep_run_unchanged(self):
         # The lockstep run is deterministic: recording must not change a single figure of it (it only adds
         # readers). The speed cost is reported here and measured properly by scripts/measure-stack.py
-        # (speed targets live in measurements, not in timed tests; docs/results/benchmarks.md "Loop benchmark").
+        # (speed targets live in measurements, not in timed tests; docs/results/recording-cost.md).
         code, s, err = self.tmp.run_json("step-in-place.yaml", DOMAIN_BASE + 2)
         self.assertEqual(code, 0, err[-2000:])
         plain, recorded = s["services"]["mft-sim"], self.summary["services"]["mft-sim"]

@@ -201,15 +201,17 @@ def _write_csv(path, args, rows, sens_rows):
                             for c in args.controllers for k in ("imax_Ns", "stepping_height_m")])
 
 
-def _markdown(args, sweep, rows, sens_rows, defaults_stepping, wall, load):
-    """ablation.md: the variants' table, the recoveries above a failure, the sensitivity table, the wall time."""
-    res = sweep.results
-    d = sweep.setup.direction
-    hs = args.heights
-    lines = [f"Ablation: each departure from the paper's setup alone ({d} push at a {sweep.setup.liftoff}-foot lift-off, "
-             f"grid {args.start:g} + k·{args.step:g} N s, search {args.search}"
-             + (f" {args.coarse:g} N s then {args.step:g}" if args.search == "coarse" else "")
-             + f", runner {sweep.grid['runner']})", "",
+def markdown_lines(report):
+    """ablation.md from the report ablation.json holds: the variants' table, the recoveries above a failure, the
+    sensitivity table, the wall time. Also renders a committed ablation.json for the docs."""
+    grid, setup, sens = report["grid"], report["setup"], report["sensitivity"]
+    hs, rows, sens_rows, controllers = report["heights"], report["rows"], sens["rows"], report["controllers"]
+    duration_s = round(setup["push_after_s"] + setup["observe_s"], 6)
+    lines = [f"Ablation: each departure from the paper's setup alone ({setup['direction']} push at a "
+             f"{setup['liftoff']}-foot lift-off, grid {grid['start_Ns']:g} + k·{grid['step_Ns']:g} N s, search "
+             f"{grid['search']}"
+             + (f" {grid['coarse_Ns']:g} N s then {grid['step_Ns']:g}" if grid["search"] == "coarse" else "")
+             + f", runner {grid['runner']})", "",
              "| variant | " + " | ".join(f"{h:.2f} m SA / MFT [N s] (MFT/SA)" for h in hs) + " | what it changes |",
              "|---" * (len(hs) + 2) + "|"]
     for r in rows:
@@ -225,21 +227,23 @@ def _markdown(args, sweep, rows, sens_rows, defaults_stepping, wall, load):
         lines += ["", "Recoveries above the first failure (seen within --above of it, on the grid searched):", ""]
         lines += [f"- {v} {h:.2f} m {CONTROLLER_NAMES[c]}: {', '.join(f'{a:g}' for a in a_)} N s" for v, h, c, a_ in above]
     if sens_rows:
-        lines += ["", f"I_max against {args.param} at {args.sensitivity_height:.2f} m, and the stepping height there "
-                      f"(mean base height over the last second of {sweep.setup.duration_s:g} s of stepping, no push):", "",
-                  f"| {args.param} | " + " | ".join(f"I_max {CONTROLLER_NAMES[c]} [N s]" for c in args.controllers) +
-                  " | " + " | ".join(f"stepping height {CONTROLLER_NAMES[c]} [m]" for c in args.controllers) + " |",
-                  "|---" * (1 + 2 * len(args.controllers)) + "|"]
+        lines += ["", f"I_max against {sens['param']} at {sens['height_m']:.2f} m, and the stepping height there "
+                      f"(mean base height over the last second of {duration_s:g} s of stepping, no push):", "",
+                  f"| {sens['param']} | " + " | ".join(f"I_max {CONTROLLER_NAMES[c]} [N s]" for c in controllers) +
+                  " | " + " | ".join(f"stepping height {CONTROLLER_NAMES[c]} [m]" for c in controllers) + " |",
+                  "|---" * (1 + 2 * len(controllers)) + "|"]
         for r in sens_rows:
             lines.append(f"| {r['value']:g} | " + " | ".join("–" if r[f"{c}_imax_Ns"] is None else f"{r[f'{c}_imax_Ns']:.1f}"
-                                                          for c in args.controllers) + " | " +
+                                                          for c in controllers) + " | " +
                          " | ".join("–" if r[f"{c}_stepping_height_m"] is None else f"{r[f'{c}_stepping_height_m']:.4f}"
-                                    for c in args.controllers) + " |")
+                                    for c in controllers) + " |")
         lines += ["", "Stepping height with the defaults: " + ", ".join(
-            f"{CONTROLLER_NAMES[c]} {'–' if v is None else f'{v:.4f} m'}" for c, v in defaults_stepping.items())]
-    if wall is not None:
-        lines += ["", f"Wall time of this invocation: {wall / 60:.1f} min (load average before / after: {load[0]} / "
-                      f"{load[1]}); {sweep.new_runs} new runs, {len(res.runs)} on file."]
+            f"{CONTROLLER_NAMES[c]} {'–' if v is None else f'{v:.4f} m'}"
+            for c, v in sens["defaults_stepping_height_m"].items())]
+    if report["wall_s"] is not None:
+        load = report["load_average"]
+        lines += ["", f"Wall time of this invocation: {report['wall_s'] / 60:.1f} min (load average before / after: "
+                      f"{load[0]} / {load[1]}); {report['new_runs']} new runs, {report['runs_on_file']} on file."]
     return lines
 
 
@@ -252,13 +256,14 @@ def write_report(args, sweep, variants, sens_variants, sens, wall, load):
     out = Path(args.out)
     hs = args.heights
     _write_csv(out / "ablation.csv", args, rows, sens_rows)
-    lines = _markdown(args, sweep, rows, sens_rows, defaults_stepping, wall, load)
-    (out / "ablation.md").write_text("\n".join(lines) + "\n")
-    return {"kind": "ablation", "out": str(out), "grid": sweep.grid, "heights": hs, "rows": rows,
-            "sensitivity": {"param": args.param, "height_m": args.sensitivity_height, "rows": sens_rows,
-                            "defaults_stepping_height_m": defaults_stepping},
-            "setup": asdict(sweep.setup), "wall_s": None if wall is None else round(wall, 1), "new_runs": sweep.new_runs,
-            "load_average": list(load), "table_md": str(out / "ablation.md"), "table_csv": str(out / "ablation.csv")}
+    report = {"kind": "ablation", "out": str(out), "grid": sweep.grid, "heights": hs, "controllers": args.controllers,
+              "rows": rows, "sensitivity": {"param": args.param, "height_m": args.sensitivity_height, "rows": sens_rows,
+                                            "defaults_stepping_height_m": defaults_stepping},
+              "setup": asdict(sweep.setup), "wall_s": None if wall is None else round(wall, 1),
+              "new_runs": sweep.new_runs, "runs_on_file": len(res.runs), "load_average": list(load),
+              "table_md": str(out / "ablation.md"), "table_csv": str(out / "ablation.csv")}
+    (out / "ablation.md").write_text("\n".join(markdown_lines(report)) + "\n")
+    return report
 
 
 def plot(args, report):

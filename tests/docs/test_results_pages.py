@@ -5,7 +5,8 @@ A results page marks a generated block with
 (FILE relative to docs/). KIND recovery-map: the block's table rows and outcome lines are what
 `mft-experiment recovery-map` writes to table.md for that map.json (its own renderer, run again here);
 KIND realtime: the rows `scripts/realtime-table.py` makes of those measure-stack.py JSON files;
-KIND table-ii: the table and cell lines `mft-experiment push-sweep` writes to table.md for that summary.json.
+KIND table-ii: the table and cell lines `mft-experiment push-sweep` writes to table.md for that summary.json;
+KIND ablation: the tables and lines `mft-experiment ablation` writes to ablation.md for that ablation.json.
 Also: the README's Table II, and the stack Table II the recovery map prints beside its lift-off column, are the
 push sweep's of the table-ii block.
 """
@@ -35,7 +36,8 @@ class ResultsPages(unittest.TestCase):
     def setUpClass(cls):
         cls.root = pathlib.Path(ARGS.source_dir).resolve()
         sys.path.insert(0, str(cls.root / "python"))
-        from mftexp import recovery_report, report
+        from mftexp import ablation, recovery_report, report
+        cls.ablation = ablation
         cls.recovery_report = recovery_report
         cls.sweep_report = report
         cls.realtime_table = load_module(cls.root / "scripts" / "realtime-table.py", "realtime_table")
@@ -50,6 +52,9 @@ class ResultsPages(unittest.TestCase):
         elif kind == "table-ii":
             self.assertEqual(len(paths), 1)
             lines = self.sweep_report.table_lines(*self.sweep_report.table_from_summary(json.loads(paths[0].read_text())))
+        elif kind == "ablation":
+            self.assertEqual(len(paths), 1)
+            lines = self.ablation.markdown_lines(json.loads(paths[0].read_text()))
         elif kind == "realtime":
             lines = self.realtime_table.table([str(p) for p in paths])
         else:

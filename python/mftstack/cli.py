@@ -383,10 +383,10 @@ def stack_options(sp):
                     "(one SCHED_FIFO thread per CPU, 1 ms): the summary then says which deadline misses fell in "
                     "a stall of the machine (costs ~30 us of p50 latency on a 2-vCPU VM)")
     sp.add_argument("--rt-priorities", choices=["chain", "flat"], help="realtime: SCHED_FIFO "
-                    "priorities rising along the chain to the simulator (chain, the default: estimator 76, planner "
-                    "77, wbc 78, sim 79; with the chain on one core each hand-off is a same-core preemption) or 80 "
-                    "for all (flat, the default with --secure, where the chain's priorities lost the chain); "
-                    "docs/results/loop-benchmark.md")
+                    "priorities rising along the chain to the simulator (chain: estimator 76, planner 77, wbc 78, "
+                    "sim 79; with the chain on one core each hand-off is a same-core preemption; the default for a "
+                    "chain pinned to one core on the shared-memory channel) or 80 for all (flat: the default "
+                    "otherwise, e.g. with --secure or --stack); docs/results/loop-benchmark.md")
     sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
                     "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
     sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "

@@ -151,24 +151,25 @@ def chain_shm_name(args, multi_host):
 RT_CHAIN_PRIORITIES = {"mft-estimator": 76, "mft-planner": 77, "mft-wbc": 78, "mft-sim": 79}
 
 
-def rt_priorities_for(args):
-    """--rt-priorities as given, else "chain", except "flat" for a --secure stack. Measured on a 2-vCPU VM
-    (docs/results/loop-benchmark.md, "Secured stacks"): a secured standing stack in realtime fell in 4 of 9 runs of
-    20-90 s with the chain's priorities (its chain rides secured DDS: it missed most deadlines, or the estimator's
-    input stopped for good) and in none of 7 with flat ones; plain DDS with the chain's priorities in none of 7."""
+def rt_priorities_for(args, pinned_shm_chain):
+    """--rt-priorities as given, else "chain" for a chain pinned to one core on the shared-memory channel (where it
+    was measured to pay: docs/results/loop-benchmark.md), else "flat". Measured on a 2-vCPU VM: a secured standing
+    stack (its chain on secured DDS) fell in 4 of 9 runs of 20-90 s with the chain's priorities and in none of 7
+    flat; a three-host stack (DDS, unpinned) with the chain's priorities fell in its realtime test in a clean-clone
+    CI run and in loaded series, where it had passed 20 of 20 flat (docs/guide/testing.md)."""
     given = getattr(args, "rt_priorities", None)
     if given:
         return given
-    return "flat" if getattr(args, "secure", None) else "chain"
+    return "chain" if pinned_shm_chain else "flat"
 
 
-def realtime_options(name, args):
-    """The options of service `name` for the realtime knobs: --rt-priority with --rt-priorities chain, mft-sim's
-    --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
+def realtime_options(name, args, priorities):
+    """The options of service `name` for the realtime knobs: --rt-priority with priorities "chain" (from
+    rt_priorities_for), mft-sim's --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
     if args.mode != "realtime" or getattr(args, "no_rt", False):
         return []
     extra = []
-    if rt_priorities_for(args) == "chain" and name in RT_CHAIN_PRIORITIES:
+    if priorities == "chain" and name in RT_CHAIN_PRIORITIES:
         extra += ["--rt-priority", str(RT_CHAIN_PRIORITIES[name])]
     if name == "mft-sim" and getattr(args, "sim_spin_us", 0):
         extra += ["--spin-us", str(args.sim_spin_us)]
@@ -312,6 +313,7 @@ class Stack:
         self.chain_cpu = chain_cpu_for(getattr(args, "chain_cpu", None), args.mode, args.domain, bool(self.stack))
         explicit = getattr(args, "chain_cpu", None) not in (None, "auto", "none")
         placement = cpu_placement(self.chain_cpu, names, recorder_elsewhere=explicit)
+        self.rt_priorities = rt_priorities_for(args, bool(self.chain_shm) and self.chain_cpu is not None)
         for name in names:
             argv = [str(Path(args.bin_dir) / name)] + common
             host = None
@@ -321,7 +323,7 @@ class Stack:
             if self.chain_shm and (name != "mft-record" or args.mode == "lockstep"):
                 # the four chain services, and in lockstep the recorder (its window keeps it inside the rings)
                 argv += ["--chain-shm", self.chain_shm]
-            argv += realtime_options(name, args)
+            argv += realtime_options(name, args, self.rt_priorities)
             if name == "mft-record":
                 argv += ["--output", str(Path(args.record).resolve())] + (["--overwrite"] if args.overwrite else [])
             if name == "mft-sim" and getattr(args, "record", None) and args.mode == "lockstep" and RECORDER_WINDOW_TICKS:

@@ -3,7 +3,7 @@ import json
 import sys
 from pathlib import Path
 
-from .processes import rt_priorities_for, write_atomically
+from .processes import write_atomically
 
 
 def write_summary_file(stack, summary):
@@ -82,7 +82,7 @@ def build_summary(stack, wall_s, error):
         "run_dir": str(stack.run_dir), "ok": error is None and not stack.failed, "error": error,
         "secure": bool(getattr(stack.args, "secure", None)), "chain_cpu": getattr(stack, "chain_cpu", None),
         "chain_transport": "shm" if getattr(stack, "chain_shm", None) else "dds",
-        "rt_priorities": rt_priorities_for(stack.args) if stack.args.mode == "realtime" else None,
+        "rt_priorities": getattr(stack, "rt_priorities", None) if stack.args.mode == "realtime" else None,
         "stack": dict(stack.stack.describe(), services=stack.hosts(), only_host=stack.only_host) if stack.stack else None,
         "fell": sim.get("fell"), "sim_time_s": sim.get("sim_time_s"), "wall_time_s": round(wall_s, 3),
         "ticks": sim.get("ticks"), "real_time_factor": None,

@@ -18,7 +18,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "python"))
 from mftstack.simlog import HELPER_FIFO_PRIORITY, helper_realtime_prefix, reserve_cpu_share  # noqa: E402
 from mftstack.errors import SupervisorError  # noqa: E402
-from mftstack.processes import chain_cpu_for, chain_shm_name, cpu_placement, realtime_options  # noqa: E402
+from mftstack.processes import (chain_cpu_for, chain_shm_name, cpu_placement, realtime_options,  # noqa: E402
+                                 rt_priorities_for)
 from mftstack.summary import gaps_in_stalls, stalled_within  # noqa: E402
 from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
@@ -102,36 +103,32 @@ class RealtimeKnobsTest(unittest.TestCase):
     """--rt-priorities and --sim-spin-us reach the services they are for, in realtime with --rt only."""
 
     def args(self, **kw):
-        base = dict(mode="realtime", no_rt=False, rt_priorities="chain", sim_spin_us=0)
+        base = dict(mode="realtime", no_rt=False, rt_priorities=None, sim_spin_us=0)
         base.update(kw)
         return argparse.Namespace(**base)
 
     def test_priorities_rise_along_the_chain(self):
-        args = self.args()  # the default
+        args = self.args()
         chain = ["mft-estimator", "mft-planner", "mft-wbc", "mft-sim"]  # the simulator consumes the command
-        prios = [int(realtime_options(n, args)[1]) for n in chain]
+        prios = [int(realtime_options(n, args, "chain")[1]) for n in chain]
         self.assertEqual(prios, sorted(prios))
         self.assertEqual(len(set(prios)), 4)
         self.assertTrue(all(1 <= p < 80 for p in prios))  # below the stall probe and the tests' watchers (85)
-        self.assertEqual(realtime_options("mft-record", args), [])
-        self.assertEqual(realtime_options("mft-wbc", self.args(rt_priorities="flat")), [])
+        self.assertEqual(realtime_options("mft-record", args, "chain"), [])
+        self.assertEqual(realtime_options("mft-wbc", args, "flat"), [])
 
-    def test_a_secured_stack_runs_flat_unless_told(self):
-        chain = ["mft-estimator", "mft-planner", "mft-wbc", "mft-sim"]
-        secured = self.args(rt_priorities=None, secure="/keys")
-        self.assertEqual([realtime_options(n, secured) for n in chain], [[]] * 4)  # all at the services' 80
-        plain = self.args(rt_priorities=None)
-        self.assertEqual([realtime_options(n, plain)[1] for n in chain], ["76", "77", "78", "79"])
-        told = self.args(rt_priorities="chain", secure="/keys")
-        self.assertEqual(realtime_options("mft-sim", told), ["--rt-priority", "79"])
+    def test_the_chains_priorities_are_the_default_only_for_a_pinned_chain_on_shared_memory(self):
+        self.assertEqual(rt_priorities_for(self.args(), pinned_shm_chain=True), "chain")
+        self.assertEqual(rt_priorities_for(self.args(), pinned_shm_chain=False), "flat")  # --secure, --stack, ...
+        self.assertEqual(rt_priorities_for(self.args(rt_priorities="chain"), pinned_shm_chain=False), "chain")
+        self.assertEqual(rt_priorities_for(self.args(rt_priorities="flat"), pinned_shm_chain=True), "flat")
 
     def test_spin_goes_to_the_simulator_alone_and_nothing_in_lockstep(self):
-        flat = dict(rt_priorities="flat")
-        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150, **flat)), ["--spin-us", "150"])
-        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150, **flat)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True)), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(**flat)), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150), "flat"), ["--spin-us", "150"])
+        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150), "flat"), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150), "chain"), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True), "chain"), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(), "flat"), [])
 
 
 class ChainTransportTest(unittest.TestCase):

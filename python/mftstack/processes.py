@@ -142,12 +142,13 @@ def chain_shm_name(args, multi_host):
     return f"/mft-chain-d{args.domain}-{os.getpid()}-{time.monotonic_ns() % 1000000}"
 
 
-# --rt-priorities chain (the default without --secure): SCHED_FIFO priorities rising along the chain from the estimator to the
-# simulator, which consumes the chain's end product (the command). With the chain on one core each hand-off
-# (estimator -> planner -> wbc) preempts the writer at once, and the WBC's command preempts the WBC itself: the
-# simulator has it before the writers' post-write work runs. "flat" runs them all at 80. Measured
-# (docs/results/loop-benchmark.md, "The realtime tail, measure by measure"): with the simulator lowest instead
-# (sim 76 ... wbc 79) the command waited for the estimator's and the planner's remaining work, p50 +50-100 us.
+# --rt-priorities chain (the default for a chain pinned on the shared-memory channel, rt_priorities_for): SCHED_FIFO
+# priorities rising along the chain from the estimator to the simulator, which consumes the chain's end product
+# (the command). With the chain on one core each hand-off (estimator -> planner -> wbc) preempts the writer at
+# once, and the WBC's command preempts the WBC itself: the simulator has it before the writers' post-write work
+# runs. "flat" runs them all at 80. Measured (docs/results/loop-benchmark.md, "The realtime tail, measure by
+# measure"): with the simulator lowest instead (sim 76 ... wbc 79) the command waited for the estimator's and the
+# planner's remaining work, p50 +50-100 us.
 RT_CHAIN_PRIORITIES = {"mft-estimator": 76, "mft-planner": 77, "mft-wbc": 78, "mft-sim": 79}
 
 

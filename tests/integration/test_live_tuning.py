@@ -12,7 +12,10 @@ key, key not tunable) and a non-zero exit, and `mft-supervisor status` listing w
 Needs MFT_BIN_DIR (set by CTest)."""
 import csv
 import concurrent.futures
+import contextlib
 import json
+import os
+import signal
 import subprocess
 import sys
 import time
@@ -25,8 +28,7 @@ from mftstack.testing import BIN, SCENARIOS, StackRunner, StackUpTestCase  # noq
 
 DOMAIN_LOCKSTEP, DOMAIN_REALTIME = 98, 99
 AT_S = 12.0        # the change's simulated time
-# Of the standing run: at ~20x real time, 60 s after the change leave the two refusals ~3 s of wall time to reach the
-# stack (24 s left 0.6 s: a loaded clean-clone CI run lost that race once).
+# Of the standing run: 60 s after the change for the base to settle (the refusals are sent with the run held).
 DURATION_S = 72.0
 KP_BEFORE, KP_AFTER = 400.0, 100.0
 
@@ -67,6 +69,23 @@ def replay(rawlog, *extra):
         raise AssertionError(f"mft-replay printed no JSON (exit {p.returncode}): {p.stderr[-2000:]}")
 
 
+def simulator_of(proc):
+    """The pid of the mft-sim the supervisor process `proc` started."""
+    pids = [pid for pid, comm, _, _ in testing.child_processes(proc.pid) if comm == "mft-sim"]
+    assert len(pids) == 1, f"the stack's mft-sim is not running (the run ended early?): {pids}"
+    return pids[0]
+
+
+@contextlib.contextmanager
+def held(pid):
+    """A lockstep stack stands still while its simulator (our child's child, by pid) is stopped."""
+    os.kill(pid, signal.SIGSTOP)
+    try:
+        yield
+    finally:
+        os.kill(pid, signal.SIGCONT)
+
+
 class LiveTuningInLockstep(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -94,11 +113,14 @@ class LiveTuningInLockstep(unittest.TestCase):
         cls.set_result = mft_cmd(DOMAIN_LOCKSTEP, "--set", f"wbc.gains.base_z.kp={KP_AFTER:g}", "--at", AT_S,
                                  "--timeout", 60, "--verdict-timeout", 60)
         # Refused by a lockstep stack: a change without a stated time, and one at a time already passed (both sent
-        # at once: the stack does not wait for them).
-        with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
-            no_at = pool.submit(mft_cmd, DOMAIN_LOCKSTEP, "--set", "wbc.weights.slack=1e4", "--timeout", 30)
-            passed = pool.submit(mft_cmd, DOMAIN_LOCKSTEP, "--set", "wbc.weights.slack=1e4", "--at", 0.5, "--timeout", 30)
-            cls.no_at, cls.passed = no_at.result(), passed.result()
+        # at once). The simulator is held (SIGSTOP) meanwhile: the WBC judges requests off its loop, but a run that
+        # ends before a new mft-cmd's discovery is done never hears it (seconds with both cores loaded).
+        with held(simulator_of(proc)):
+            with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
+                no_at = pool.submit(mft_cmd, DOMAIN_LOCKSTEP, "--set", "wbc.weights.slack=1e4", "--timeout", 30)
+                passed = pool.submit(mft_cmd, DOMAIN_LOCKSTEP, "--set", "wbc.weights.slack=1e4", "--at", 0.5,
+                                     "--timeout", 30)
+                cls.no_at, cls.passed = no_at.result(), passed.result()
         code, cls.tuned_summary, err = cls.stacks.finish(proc, timeout=600)
         assert code == 0, f"tuned run: exit {code}: {err[-3000:]}"
         labels = ["gt_q", "joint_tau_cmd", "config_change", "command_verdict"]

@@ -49,25 +49,14 @@ void StallProbe::run(int cpu) {
   const std::int64_t period_ns = options_.period.count() * 1000;
   const std::int64_t threshold_ns = options_.threshold.count() * 1000;
   std::int64_t next = steadyNs();
-  std::int64_t aligned_to = -1;
   while (!stop_) {
     next += period_ns;
-    const std::int64_t origin = origin_ns_.load(std::memory_order_relaxed);
-    if (origin != aligned_to && origin >= 0) next = nextOnGrid(next, origin, period_ns);
-    aligned_to = origin;
     timespec ts{static_cast<time_t>(next / 1000000000LL), static_cast<long>(next % 1000000000LL)};
     clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr);  // steady_clock is CLOCK_MONOTONIC here
     const std::int64_t woke = steadyNs();
     if (woke - next > threshold_ns) recordStall(next, woke);
     if (woke - next > period_ns) next = woke;  // after a stall, do not run the missed periods back to back
   }
-}
-
-std::int64_t StallProbe::nextOnGrid(std::int64_t after_ns, std::int64_t origin_ns, std::int64_t period_ns) {
-  if (period_ns <= 0) return after_ns;
-  std::int64_t offset = (after_ns - origin_ns) % period_ns;
-  if (offset < 0) offset += period_ns;
-  return offset == 0 ? after_ns : after_ns - offset + period_ns;
 }
 
 void StallProbe::recordStall(std::int64_t from_ns, std::int64_t to_ns) {

@@ -36,12 +36,6 @@ class StallProbe {
   // the chain's p99 is under 0.5 ms, so missing 3 ms takes a stall of that order (or a chain too slow on
   // every tick, which the damping totals show).
   static bool explainsMiss(std::int64_t stalled_ns, std::int64_t timeout_ns) { return stalled_ns * 2 >= timeout_ns; }
-  // From now on the threads wake at origin_ns + k * period (steady_clock ns). The simulator puts them half a
-  // period after its deadlines, where the chain is idle: a probe wake-up inside the chain's hand-offs preempts
-  // it on its core (a timer interrupt and two context switches on this VM).
-  void alignWakeupsTo(std::int64_t origin_ns) { origin_ns_.store(origin_ns, std::memory_order_relaxed); }
-  // The first wake-up after `after_ns` on the grid origin_ns + k * period_ns (a pure function, for tests).
-  static std::int64_t nextOnGrid(std::int64_t after_ns, std::int64_t origin_ns, std::int64_t period_ns);
   std::uint64_t stalls() const;
   // The stalls kept [from, to) ns (steady_clock, which every process shares): the supervisor judges the other
   // services' deadline misses against them.
@@ -64,7 +58,6 @@ class StallProbe {
   std::uint64_t stalls_ = 0;
   std::int64_t max_stall_ns_ = 0, total_stall_ns_ = 0;
   std::atomic<bool> stop_{false};
-  std::atomic<std::int64_t> origin_ns_{-1};  // -1: the threads keep their own phase
   std::atomic<int> probing_{0};  // probe threads pinned to their CPU
   std::atomic<int> started_{0};  // probe threads that tried their CPU
   bool realtime_priority_ = true;

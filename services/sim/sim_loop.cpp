@@ -21,8 +21,6 @@ void SimLoop::declareOptions(CommandLine& cli) {
   cli.option("stall-probe-us", "realtime: period of the CPU stall probe (one SCHED_FIFO thread per CPU that tells\n"
              "                             the machine's stalls from the chain's misses; costs ~30 us of p50 latency\n"
              "                             on a 2-vCPU VM; 0 = off) [us]", "0");
-  cli.option("stall-probe-offset-us", "realtime: the probe wakes this long after each of the simulator's deadlines,\n"
-             "                             where the chain is idle (-1 = its own phase, as before 2026-11-28) [us]", "500");
   cli.option("spin-us", "realtime: wake this long before each 1 kHz deadline and poll the clock to it (0 = sleep to\n"
              "                             the deadline; docs/results/loop-benchmark.md) [us]", "0");
   cli.option("max-push", "largest disturbance impulse accepted from the Disturbance topic [N s]", "200");
@@ -117,7 +115,6 @@ void SimLoop::run() {
   pacer_.emplace(control_period_s_, watchdog_ns_, std::chrono::microseconds(cli_.getInt("spin-us", 0, 900)));
   exchange_.emplace(ctx_.lockstep(), TickExchange::Timeouts{command_timeout_, start_timeout_, resend_}, link_,
                     recorder_, *pacer_, hops_);
-  alignStallProbe();
   const std::function<void()> publish_tick = [this] { publish(); };
   while (!shutdownRequested() && (cli_.isSet("forever") || node_->tick() < node_->ticksTotal())) {
     const std::uint64_t k = node_->tick();
@@ -126,13 +123,6 @@ void SimLoop::run() {
     if (!step(k, command)) break;
     reportProgress();
   }
-}
-
-void SimLoop::alignStallProbe() {
-  const long offset_us = cli_.getInt("stall-probe-offset-us", -1, 999);
-  if (!stall_probe_ || offset_us < 0) return;
-  const auto origin = pacer_->deadline() + std::chrono::microseconds(offset_us);
-  stall_probe_->alignWakeupsTo(std::chrono::duration_cast<std::chrono::nanoseconds>(origin.time_since_epoch()).count());
 }
 
 // Tick k's physics step with its pushes; false when the robot fell and the run ends there.

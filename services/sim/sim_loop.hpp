@@ -43,7 +43,6 @@ class SimLoop {
   using Clock = std::chrono::steady_clock;
   bool awaitChain();  // false (after saying why on stderr) when the chain did not connect or answer in time
   void run();         // the loop; error_ says why it stopped early
-  void alignStallProbe();  // the probe wakes between ticks, not inside the chain's hand-offs
   bool step(std::uint64_t k, const model::ActuatorCommand& command);  // false: the run ends at a fall
   void reportProgress();
   int finish();

@@ -111,17 +111,3 @@ TEST(StallProbe, RecordsTheProcessBeingStopped) {
   EXPECT_GE(result[0], 1.0);
   EXPECT_GE(result[1], 30.0);
 }
-
-TEST(StallProbe, AlignedWakeupsLandOnTheGridAfterTheGivenTime) {
-  const std::int64_t period = 1000000, origin = 5500000;  // half a period after deadlines at whole ms
-  EXPECT_EQ(StallProbe::nextOnGrid(5500000, origin, period), 5500000);
-  EXPECT_EQ(StallProbe::nextOnGrid(5500001, origin, period), 6500000);
-  EXPECT_EQ(StallProbe::nextOnGrid(7000000, origin, period), 7500000);
-  EXPECT_EQ(StallProbe::nextOnGrid(2100000, origin, period), 2500000);  // before the origin: the grid extends back
-  for (std::int64_t t = 0; t < 3 * period; t += 123457) {
-    const std::int64_t next = StallProbe::nextOnGrid(t, origin, period);
-    EXPECT_GE(next, t);
-    EXPECT_LT(next - t, period);
-    EXPECT_EQ((next - origin) % period, 0);
-  }
-}

@@ -38,6 +38,25 @@ bool isUtf8(const std::string& text) {
   return true;
 }
 
+std::string printableText(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const auto u = static_cast<unsigned char>(text[i]);
+    const std::size_t n = u >= 0x80 ? utf8Length(text, i) : (u >= 0x20 && u != 0x7f ? 1 : 0);
+    if (n > 0) {
+      out.append(text, i, n);
+      i += n;
+      continue;
+    }
+    char hex[5];
+    std::snprintf(hex, sizeof hex, "\\x%02x", u);
+    out += hex;
+    ++i;
+  }
+  return out;
+}
+
 std::string jsonEscape(const std::string& text) {
   std::string out;
   out.reserve(text.size() + 8);

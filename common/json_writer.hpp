@@ -15,6 +15,10 @@ namespace mft::config {
 // The length of the UTF-8 sequence that starts at `at` (1-4), or 0 if the bytes there are not one.
 std::size_t utf8Length(const std::string& text, std::size_t at);
 bool isUtf8(const std::string& text);
+// Text for a one-line message on a terminal or in a log: whole UTF-8 sequences and printable ASCII as they are,
+// every other byte (a control character, a byte that is not UTF-8) as \xNN. A message that quotes bytes of a
+// foreign file stays readable and valid UTF-8.
+std::string printableText(const std::string& text);
 // The text of a JSON string without the quotes: '"', '\\' and every control character escaped (RFC 8259),
 // so that a scenario name or a file name with a tab or an ESC still gives valid JSON. A whole UTF-8 sequence
 // passes; a byte that is not part of one (Latin-1) becomes \ufffd, so the JSON stays UTF-8.

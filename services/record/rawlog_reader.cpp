@@ -6,6 +6,8 @@
 
 #include <mrpt/obs/CObservationIMU.h>
 
+#include "common/json_writer.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -193,6 +195,8 @@ class ObjectBounds {
 
 }  // namespace
 
+NotMftRawlog::NotMftRawlog(const std::string& message) : std::runtime_error(config::printableText(message)) {}
+
 const char* toString(RawlogReader::End e) {
   switch (e) {
     case RawlogReader::End::None: return "none";
@@ -282,9 +286,9 @@ std::string RawlogReader::endMessage() const {
     case End::None: return "not read to the end";
     case End::Clean: return "complete (" + n + ")";
     case End::Truncated: return "truncated: " + end_detail_ + "; " + n + " (everything up to the last whole record)";
-    case End::Corrupt:
+    case End::Corrupt:  // the detail may quote the file's bytes
       return "corrupt after " + n + " (" + std::to_string(stream_.getPosition()) +
-             " bytes decompressed): " + end_detail_;
+             " bytes decompressed): " + config::printableText(end_detail_);
   }
   return "";
 }

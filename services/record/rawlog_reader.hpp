@@ -15,10 +15,11 @@
 
 namespace mft::rawlog {
 
-// The file is not an mft rawlog (or of an unsupported schema): what() is the message for the user.
+// The file is not an mft rawlog (or of an unsupported schema): what() is the message for the user, with the
+// file's own bytes it quotes made printable.
 class NotMftRawlog : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit NotMftRawlog(const std::string& message);
 };
 
 class RawlogReader {

@@ -34,8 +34,8 @@ def report(key, value):
     print(f"\n[rawlog] {key}: {json.dumps(value)}", file=sys.stderr, flush=True)
 
 
-def run(cmd, timeout=300, **kw):
-    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=timeout, **kw)
+def run(cmd, timeout=300, text=True, **kw):
+    return subprocess.run([str(c) for c in cmd], capture_output=True, text=text, timeout=timeout, **kw)
 
 
 class RecordedLockstepRun(unittest.TestCase):
@@ -202,6 +202,12 @@ class RecordedLockstepRun(unittest.TestCase):
                 p = run([BIN / tool[0]] + tool[1:])
                 self.assertEqual(p.returncode, 2, (tool, p.stderr))
                 self.assertIn(why, p.stderr, tool)
+        # A foreign class name quoted in the message (a fuzzer's input): its bytes printable, the message UTF-8.
+        foreign_class = Path(__file__).resolve().parents[2] / "fuzz/corpus/rawlog/slow-under-load-foreign-class-name.rawlog"
+        p = run([BIN / "mft-export", foreign_class, "--info"], text=False)
+        err = p.stderr.decode("utf-8")  # raises on a byte that is not UTF-8
+        self.assertEqual(p.returncode, 4, err)
+        self.assertIn("object 35: a mrp\u0533\\x0f\\xcf", err)
         report("bad_input", {"truncated_half": {"gt_q_ticks": n}, "corrupt": info["end_message"]})
 
     def test_6_export_csv_and_plot(self):

@@ -114,8 +114,10 @@ TEST(ConfigText, Latin1IsRefusedAndJsonStaysUtf8) {
   }
   EXPECT_EQ(config::jsonEscape("caf\xe9 \xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 \xc0\xaf"),
             "caf\\ufffd \xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80 \\ufffd\\ufffd");
-  // A message quoting a foreign file's bytes: UTF-8 and printable ASCII kept, every other byte as \xNN.
-  EXPECT_EQ(config::printableText("a mrp\xd4\xb3\x0f caf\xc3\xa9\x7f\n"), "a mrp\\xd4\\xb3\\x0f caf\xc3\xa9\\x7f\\x0a");
+  // A message quoting a foreign file's bytes: whole UTF-8 sequences (U+0533 here) and printable ASCII kept,
+  // every other byte (a control byte, a lead byte without its continuation, DEL, newline) as \xNN.
+  EXPECT_EQ(config::printableText("a mrp\xd4\xb3\x0f\xcf caf\xc3\xa9\x7f\n"),
+            "a mrp\xd4\xb3\\x0f\\xcf caf\xc3\xa9\\x7f\\x0a");
   EXPECT_TRUE(config::isUtf8(config::printableText("\xff\xfe\xc0\xaf\xed\xa0\x80")));
   EXPECT_TRUE(config::isUtf8("\xc3\xa9"));
   EXPECT_FALSE(config::isUtf8("\xed\xa0\x80"));  // a UTF-16 surrogate

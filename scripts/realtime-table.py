@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Markdown rows of the realtime figures of measure-stack.py JSON files, one row per file (docs/results pages quote
-these rows; test docs_results_pages regenerates them from the files the page cites)."""
+"""Markdown rows of the figures of measure-stack.py JSON files, one row per file: the realtime run's (default) or,
+with --lockstep, the lockstep rounds' (speed ratio to the in-process run, recording cost). docs/results pages quote
+these rows; test docs_results_pages regenerates them from the files the page cites."""
 import argparse
 import json
 import sys
@@ -32,12 +33,36 @@ def table(paths):
     return HEADER + [row(p) for p in paths]
 
 
+LOCKSTEP_HEADER = ["| run | rounds | µs per tick lockstep / in process | speed ratio to in process, median (min–max) "
+                   "| recording every topic: slowdown median (min–max) | samples dropped | timer lateness p99 per CPU "
+                   "[µs] | load before → after |",
+                   "|---|---|---|---|---|---|---|---|"]
+
+
+def lockstep_row(path):
+    d = json.loads(Path(path).read_text())
+    lock, rec = next(iter(d["lockstep"].values())), d["recording"]
+    ratios, slow = lock["ratio_to_inprocess_per_round"], rec["slowdown_per_round"]
+    late = d.get("machine_wakeup", {}).get("timer_late_us", {})
+    floor = ", ".join(f"{k} {v['p99']:.0f}" for k, v in sorted(late.items())) or "not measured"
+    return (f"| {Path(path).stem} | {d['rounds']} | {lock['us_per_tick_median']:.1f} / "
+            f"{d['inprocess']['us_per_tick_median']:.1f} | {lock['ratio_to_inprocess_median']:.3f} "
+            f"({min(ratios):.3f}–{max(ratios):.3f}) | ×{rec['slowdown_median']:.3f} ({min(slow):.3f}–{max(slow):.3f}) "
+            f"| {rec['dropped_samples']} | {floor} | "
+            f"{d['load_average_before']['1min']:.2f} → {d['load_average_after']['1min']:.2f} |")
+
+
+def lockstep_table(paths):
+    return LOCKSTEP_HEADER + [lockstep_row(p) for p in paths]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("files", nargs="+", help="JSON files written by scripts/measure-stack.py --json")
+    ap.add_argument("--lockstep", action="store_true", help="the lockstep rounds' row instead of the realtime run's")
     a = ap.parse_args()
     try:
-        print("\n".join(table(a.files)))
+        print("\n".join((lockstep_table if a.lockstep else table)(a.files)))
     except (OSError, ValueError, KeyError, StopIteration) as e:
         print(f"realtime-table: {e}", file=sys.stderr)
         return 2

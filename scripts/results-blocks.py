@@ -8,7 +8,11 @@ A page marks a block with
   table-ii      the table and cell lines `mft-experiment push-sweep` writes to table.md (summary.json)
   ablation      the tables and lines `mft-experiment ablation` writes to ablation.md (ablation.json)
   realtime      the rows `scripts/realtime-table.py` makes of measure-stack.py JSON files
-A block is compared on its table rows and list items (a sentence of the page may sit inside it). `--write`
+  lockstep      the rows `scripts/realtime-table.py --lockstep` makes of measure-stack.py JSON files
+  speed         the table `scripts/speed-table.py` makes of mft-qp bench, mft-bench and mft-wakeup JSON files
+  fault-matrix  every line `scripts/fault-matrix.py` writes to fault-matrix.md (fault-matrix.json)
+A block is compared on its table rows and list items (a sentence of the page may sit inside it), a fault matrix
+on every line (its first line holds the verdict). `--write`
 replaces the body of each block that is out of date by what its files give (a current block keeps its text);
 the default only checks, as test docs_results_pages does."""
 import argparse
@@ -35,7 +39,7 @@ def render(kind, paths):
     sys.path.insert(0, str(ROOT / "python"))
     from mftexp import ablation, recovery_report, report
     one = (lambda: json.loads(paths[0].read_text())) if len(paths) == 1 else None
-    if kind in ("recovery-map", "table-ii", "ablation") and one is None:
+    if kind in ("recovery-map", "table-ii", "ablation", "fault-matrix") and one is None:
         raise ValueError(f"a {kind} block cites one file, not {len(paths)}")
     if kind == "recovery-map":
         return recovery_report.table_lines(recovery_report.load_report(paths[0]))
@@ -45,11 +49,19 @@ def render(kind, paths):
         return ablation.markdown_lines(one())
     if kind == "realtime":
         return load_script("realtime-table").table([str(p) for p in paths])
+    if kind == "lockstep":
+        return load_script("realtime-table").lockstep_table([str(p) for p in paths])
+    if kind == "speed":
+        return load_script("speed-table").table([str(p) for p in paths])
+    if kind == "fault-matrix":
+        return load_script("fault-matrix").table_lines(one())
     raise ValueError(f"unknown generated block kind {kind}")
 
 
-def compared(lines):
-    """The lines a block is checked on."""
+def compared(kind, lines):
+    """The lines a block of KIND is checked on."""
+    if kind == "fault-matrix":
+        return [ln for ln in lines if ln.strip()]
     return [ln for ln in lines if ln.startswith(("|", "- "))]
 
 
@@ -62,7 +74,7 @@ def blocks(docs):
 def write_page(page, docs):
     def body(m):  # a block that is current keeps its text (headings, sentences); a stale one gets the renderer's
         lines = render(m.group(2), [docs / f for f in m.group(3).split()])
-        if compared(m.group(4).splitlines()) == compared(lines):
+        if compared(m.group(2), m.group(4).splitlines()) == compared(m.group(2), lines):
             return m.group(0)
         return m.group(1) + "\n".join(lines) + "\n" + m.group(5)
     old = page.read_text()
@@ -85,7 +97,7 @@ def main():
                     print(f"rewrote {page.relative_to(docs)}")
             return 0
         stale = [f"{page.relative_to(docs)}: {kind} {' '.join(files)}" for page, kind, files, body in blocks(docs)
-                 if compared(body.splitlines()) != compared(render(kind, [docs / f for f in files]))]
+                 if compared(kind, body.splitlines()) != compared(kind, render(kind, [docs / f for f in files]))]
     except (OSError, ValueError, KeyError) as e:
         print(f"results-blocks: {e}", file=sys.stderr)
         return 2

@@ -35,11 +35,12 @@ class ResultsPages(unittest.TestCase):
 
     def test_every_generated_block_is_what_its_files_give(self):
         kinds = {kind for _, kind, _, _ in self.blocks}
-        self.assertTrue({"recovery-map", "realtime", "table-ii", "ablation"} <= kinds, kinds)
+        self.assertTrue({"recovery-map", "realtime", "table-ii", "ablation", "lockstep", "speed", "fault-matrix"} <= kinds,
+                        kinds)
         for page, kind, files, body in self.blocks:
             with self.subTest(page=page.name, files=files):
                 rendered = self.results.render(kind, [self.root / "docs" / f for f in files])
-                self.assertEqual(self.results.compared(body.splitlines()), self.results.compared(rendered))
+                self.assertEqual(self.results.compared(kind, body.splitlines()), self.results.compared(kind, rendered))
 
     def test_readme_and_recovery_maps_quote_the_push_sweep_of_the_results_page(self):
         files = [files for _, kind, files, _ in self.blocks if kind == "table-ii"]

@@ -87,7 +87,7 @@ def write_page(page, docs):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--docs", default=str(ROOT / "docs"), help="the docs folder (default: the repository's)")
-    ap.add_argument("--write", action="store_true", help="rewrite every block from its files")
+    ap.add_argument("--write", action="store_true", help="render every out-of-date block again from its files")
     a = ap.parse_args()
     docs = Path(a.docs)
     try:

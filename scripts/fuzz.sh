@@ -70,6 +70,8 @@ mkdir -p "$work" "$crashes" "$build/logs"
 echo "fuzz.sh: fuzzing $target for $seconds s; new inputs: $work; crashers: $crashes/; log: $log" >&2
 started="$build/logs/$target.started"
 touch "$started"
+load_start=$(cut -d' ' -f1 /proc/loadavg)
+started_utc=$(date -u +%Y-%m-%dT%H:%MZ)
 status=0
 ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1} \
   "$build/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
@@ -91,9 +93,13 @@ if [ "$status" -ne 0 ] || [ "$found" -gt 0 ]; then
             echo "exit status $status")
 fi
 if [ $json -eq 1 ]; then
-  printf '{"target": "%s", "seconds": %s, "executions": %s, "corpus": %s, "cov": %s, "ft": %s, "crashers": %s, "finding": "%s"}\n' \
+  # where and when: the figures depend on the machine's load (libFuzzer's rate), so the JSON says what it was
+  commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+  git diff --quiet HEAD 2>/dev/null || commit="$commit+changes"
+  printf '{"target": "%s", "seconds": %s, "executions": %s, "corpus": %s, "cov": %s, "ft": %s, "crashers": %s, "finding": "%s", "commit": "%s", "started_utc": "%s", "cores": %s, "load_1min_start": %s, "load_1min_end": %s}\n' \
     "$target" "${ran:-0}" "${execs:-0}" "${corpus:-0}" "$(field cov || true)" "$(field ft || true)" "$found" \
-    "$(echo "$finding" | tr -d '"\\' | cut -c1-200)" | sed -E 's/: ,/: null,/g'
+    "$(echo "$finding" | tr -d '"\\' | cut -c1-200)" "$commit" "$started_utc" "$(nproc)" "$load_start" \
+    "$(cut -d' ' -f1 /proc/loadavg)" | sed -E 's/: ,/: null,/g'
 else
   echo "$target: ${ran:-?} s, ${execs:-?} executions, corpus ${corpus:-?}, cov $(field cov) ft $(field ft), crashers in $crashes/: $found"
   [ -z "$finding" ] || echo "$target: finding: $finding (log: $log)"

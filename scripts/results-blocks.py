@@ -11,6 +11,8 @@ A page marks a block with
   lockstep      the rows `scripts/realtime-table.py --lockstep` makes of measure-stack.py JSON files
   speed         the table `scripts/speed-table.py` makes of mft-qp bench, mft-bench and mft-wakeup JSON files
   fault-matrix  every line `scripts/fault-matrix.py` writes to fault-matrix.md (fault-matrix.json)
+  terrain-scan  the heights x speeds grid of `mft-experiment terrain-scan`'s terrain_scan.json
+  fuzzing       the table `scripts/fuzz-table.py` makes of `scripts/fuzz.sh --json` files
 A block is compared on its table rows and list items (a sentence of the page may sit inside it), a fault matrix
 on every line (its first line holds the verdict). `--write`
 replaces the body of each block that is out of date by what its files give (a current block keeps its text);
@@ -37,9 +39,9 @@ def load_script(name):
 def render(kind, paths):
     """The lines KIND's renderer makes of the files PATHS (absolute)."""
     sys.path.insert(0, str(ROOT / "python"))
-    from mftexp import ablation, recovery_report, report
+    from mftexp import ablation, recovery_report, report, terrain_scan
     one = (lambda: json.loads(paths[0].read_text())) if len(paths) == 1 else None
-    if kind in ("recovery-map", "table-ii", "ablation", "fault-matrix") and one is None:
+    if kind in ("recovery-map", "table-ii", "ablation", "fault-matrix", "terrain-scan") and one is None:
         raise ValueError(f"a {kind} block cites one file, not {len(paths)}")
     if kind == "recovery-map":
         return recovery_report.table_lines(recovery_report.load_report(paths[0]))
@@ -55,6 +57,10 @@ def render(kind, paths):
         return load_script("speed-table").table([str(p) for p in paths])
     if kind == "fault-matrix":
         return load_script("fault-matrix").table_lines(one())
+    if kind == "terrain-scan":
+        return terrain_scan.grid_lines(one())
+    if kind == "fuzzing":
+        return load_script("fuzz-table").table([str(p) for p in paths])
     raise ValueError(f"unknown generated block kind {kind}")
 
 

@@ -203,6 +203,35 @@ def write_tables(out, report):
     (out / "terrain_scan.md").write_text("\n".join(lines) + "\n")
 
 
+def grid_lines(report):
+    """The heights x speeds table of a scan with both controllers: per cell the runs that crossed the board and
+    (in brackets) traversed the course, MFT-WBC / SA-WBC; per height the walking height on flat ground. What the
+    docs' `terrain-scan` blocks hold (scripts/results-blocks.py)."""
+    cells = {(s["height_m"], s["speed_mps"], s["controller"]): s for s in report["cells"]}
+    heights = sorted({h for h, _, _ in cells})
+    speeds = sorted({v for _, v, _ in cells})
+    ctrls = [c for c in ("mft", "sa") if any(k[2] == c for k in cells)]
+    runs = sorted({s["runs"] for s in report["cells"]})
+
+    def pair(h, v, key):
+        return " / ".join("-" if (h, v, c) not in cells else str(cells[(h, v, c)][key]) for c in ctrls)
+
+    def flat(h):
+        zs = sorted({cells[k]["walking_height_on_flat_m"] for k in cells if k[0] == h}, key=lambda z: (z is None, z))
+        return " / ".join("fell" if z is None else f"{z:.3f}" for z in zs)
+    names = " / ".join(CONTROLLER_NAMES.get(c, c) for c in ctrls)
+    lines = [f"- {report['terrain']}, course shifted by {len(report['offsets_m'])} offsets "
+             f"({report['offsets_m'][0] * 100:+.0f} ... {report['offsets_m'][-1] * 100:+.0f} cm), "
+             f"{'/'.join(map(str, runs))} runs per cell; profiles: {', '.join(report['profiles']) or 'none'}",
+             f"- per cell: runs that crossed the board (traversed the course), {names}", "",
+             "| commanded height [m] (walking height on flat [m]) | " + " | ".join(f"{v:.2f} m/s" for v in speeds) + " |",
+             "|---|" + "---|" * len(speeds)]
+    for h in heights:
+        lines.append(f"| {h:.2f} ({flat(h)}) | "
+                     + " | ".join(f"{pair(h, v, 'crossed_board')} ({pair(h, v, 'traversed')})" for v in speeds) + " |")
+    return lines
+
+
 def plot_scan(path, report):
     plt = pyplot()
     cells = report["cells"]

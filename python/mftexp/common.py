@@ -140,6 +140,17 @@ def _copy_when_stable(src, dst):
 REGISTRY = ProcessRegistry(interrupted=Interrupted, death_signal=signal.SIGTERM)
 
 
+def where(e):
+    """The innermost frame an exception came from, as 'file:line in function' (a one-line error that can be
+    traced without MFT_EXPERIMENT_DEBUG; an error raised on a Dask worker carries the worker's frames)."""
+    import traceback
+    frames = traceback.extract_tb(e.__traceback__)
+    if not frames:
+        return "no traceback"
+    f = frames[-1]
+    return f"at {Path(f.filename).name}:{f.lineno} in {f.name}"
+
+
 def run_workers(worker, count, errors, interrupted_msg=None):
     """Runs worker(i) for i in 0..count-1 on threads and waits for them. Ctrl-C stops every run in flight and
     raises Interrupted; the first error a worker appended to `errors` is raised as an ExperimentError."""
@@ -164,7 +175,7 @@ def run_workers(worker, count, errors, interrupted_msg=None):
         if os.environ.get("MFT_EXPERIMENT_DEBUG"):
             import traceback
             traceback.print_exception(type(e), e, e.__traceback__)
-        raise ExperimentError(f"a worker failed: {type(e).__name__}: {e}")
+        raise ExperimentError(f"a worker failed: {type(e).__name__}: {e} ({where(e)})")
 
 
 def write_report(path, report, png, t0, as_json):

@@ -68,5 +68,23 @@ class CheckedBeforeTest(unittest.TestCase):
         self.assertIn("--checked-before", self.run_once(ok=True))
 
 
+class WorkerFailureTest(unittest.TestCase):
+    """A worker thread's unexpected exception reaches the user as one line that says where it was raised."""
+
+    def test_the_error_names_its_file_line_and_function(self):
+        errors = []
+
+        def worker(_):
+            try:
+                None.get("x")  # the AttributeError of an unexplained CI failure, raised here on purpose
+            except AttributeError as e:
+                errors.append(e)
+        with self.assertRaises(common.ExperimentError) as ctx:
+            common.run_workers(worker, 2, errors)
+        msg = str(ctx.exception)
+        self.assertIn("a worker failed: AttributeError", msg)
+        self.assertRegex(msg, r"at test_run_checks\.py:\d+ in worker\)$")
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)

@@ -72,6 +72,9 @@ started="$build/logs/$target.started"
 touch "$started"
 load_start=$(cut -d' ' -f1 /proc/loadavg)
 started_utc=$(date -u +%Y-%m-%dT%H:%MZ)
+# the code fuzzed: the commit at the start, marked when files other than the docs differ from it
+commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+git diff --quiet HEAD -- . ':(exclude)docs' ':(exclude)*.md' 2>/dev/null || commit="$commit+changes"
 status=0
 ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1} \
   "$build/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
@@ -94,8 +97,6 @@ if [ "$status" -ne 0 ] || [ "$found" -gt 0 ]; then
 fi
 if [ $json -eq 1 ]; then
   # where and when: the figures depend on the machine's load (libFuzzer's rate), so the JSON says what it was
-  commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
-  git diff --quiet HEAD 2>/dev/null || commit="$commit+changes"
   printf '{"target": "%s", "seconds": %s, "executions": %s, "corpus": %s, "cov": %s, "ft": %s, "crashers": %s, "finding": "%s", "commit": "%s", "started_utc": "%s", "cores": %s, "load_1min_start": %s, "load_1min_end": %s}\n' \
     "$target" "${ran:-0}" "${execs:-0}" "${corpus:-0}" "$(field cov || true)" "$(field ft || true)" "$found" \
     "$(echo "$finding" | tr -d '"\\' | cut -c1-200)" "$commit" "$started_utc" "$(nproc)" "$load_start" \

@@ -216,9 +216,11 @@ def grid_lines(report):
     def pair(h, v, key):
         return " / ".join("-" if (h, v, c) not in cells else str(cells[(h, v, c)][key]) for c in ctrls)
 
-    def flat(h):
-        zs = sorted({cells[k]["walking_height_on_flat_m"] for k in cells if k[0] == h}, key=lambda z: (z is None, z))
-        return " / ".join("fell" if z is None else f"{z:.3f}" for z in zs)
+    def flat(h):  # the range over the height's speeds and controllers
+        zs = [cells[k]["walking_height_on_flat_m"] for k in cells if k[0] == h]
+        shown = sorted({f"{z:.3f}" for z in zs if z is not None})
+        text = shown[0] if len(shown) == 1 else f"{shown[0]}–{shown[-1]}" if shown else ""
+        return ", ".join(filter(None, [text, "fell" if None in zs else ""]))
     names = " / ".join(CONTROLLER_NAMES.get(c, c) for c in ctrls)
     lines = [f"- {report['terrain']}, course shifted by {len(report['offsets_m'])} offsets "
              f"({report['offsets_m'][0] * 100:+.0f} ... {report['offsets_m'][-1] * 100:+.0f} cm), "
@@ -229,7 +231,19 @@ def grid_lines(report):
     for h in heights:
         lines.append(f"| {h:.2f} ({flat(h)}) | "
                      + " | ".join(f"{pair(h, v, 'crossed_board')} ({pair(h, v, 'traversed')})" for v in speeds) + " |")
-    return lines
+    return lines + ["", _failures_line(report["cells"])]
+
+
+def _failures_line(cells):
+    """What the runs that did not traverse touched first, summed over the cells."""
+    failed = sum(s["runs"] - s["traversed"] for s in cells)
+    bodies = {}
+    for s in cells:
+        for b, n in s.get("failed_first_body_contact", {}).items():
+            bodies[b] = bodies.get(b, 0) + n
+    touched = ", ".join(f"{b} {n}" for b, n in sorted(bodies.items())) or "none"
+    return (f"- of the {failed} runs that did not traverse, the first body other than a foot to touch the ground: "
+            f"{touched}; no such contact in {failed - sum(bodies.values())}")
 
 
 def plot_scan(path, report):

@@ -73,6 +73,25 @@ class TerrainScanTest(unittest.TestCase):
         self.assertIn(f"| {cell['crossed_board']}/3 | {cell['traversed']}/3 |", md)
         self.assertGreater((self.out / "terrain_scan.png").stat().st_size, 1000)
 
+    def test_the_docs_grid_counts_each_controller_and_height(self):
+        sys.path.insert(0, str(REPO / "python"))
+        from mftexp.terrain_scan import grid_lines
+
+        def cell(h, c, crossed, traversed, z):
+            return {"height_m": h, "speed_mps": 0.25, "controller": c, "runs": 3, "crossed_board": crossed,
+                    "traversed": traversed, "walking_height_on_flat_m": z}
+        report = {"terrain": "course", "profiles": ["kv-0.145"], "offsets_m": [-0.02, 0.0, 0.02],
+                  "cells": [cell(0.44, "mft", 2, 1, 0.4251), cell(0.44, "sa", 3, 3, 0.4262),
+                            cell(0.46, "mft", 0, 0, None), cell(0.46, "sa", 1, 0, 0.443)]}
+        report["cells"][0]["failed_first_body_contact"] = {"left fore shank": 2}
+        report["cells"][2]["failed_first_body_contact"] = {"left fore shank": 1, "right rear shank": 1}
+        lines = grid_lines(report)
+        self.assertIn("- course, course shifted by 3 offsets (-2 ... +2 cm), 3 runs per cell; profiles: kv-0.145",
+                      lines)
+        self.assertEqual(lines[-4:-2], ["| 0.44 (0.425–0.426) | 2 / 3 (1 / 3) |", "| 0.46 (0.443, fell) | 0 / 1 (0 / 0) |"])
+        self.assertEqual(lines[-1], "- of the 8 runs that did not traverse, the first body other than a foot to touch "
+                                    "the ground: left fore shank 3, right rear shank 1; no such contact in 4")
+
     def test_the_walking_height_shows_the_contact_weights_sag(self):
         # Table I's w_fc = 1e-3 holds the base below its command by w_fc m^2 g / (n_st w_z kp): 13.0 mm predicted in
         # single support (docs/guide/profiles.md, contact-weights-small; 15 mm measured stepping in place).

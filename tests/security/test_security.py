@@ -160,7 +160,9 @@ class SecurityTest(StackTestCase):
         run_dir = self.tmp / "run-lockstep"
         code, out, err = self.stacks.supervisor("run", SCENARIOS / "step-in-place.yaml", "--domain", DOMAIN + 2, "--secure", self.sec,
                                   "--json", "--run-dir", run_dir)
-        self.assertEqual(code, 0, err[-3000:] + "\nmft-sim.log:\n" + SimLog(run_dir / "mft-sim.log").text()[-3000:])
+        self.assertEqual(code, 0, err[-3000:] + "".join(  # every service's last lines: which hop stopped answering
+            f"\n{name}.log:\n" + SimLog(run_dir / f"{name}.log").text()[-1500:]
+            for name in ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc") if (run_dir / f"{name}.log").exists()))
         s = json.loads(out)
         self.assertTrue(s["secure"])
         self.assertFalse(s["fell"], s["services"]["mft-sim"].get("fall_reason"))

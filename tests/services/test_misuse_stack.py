@@ -100,12 +100,14 @@ class MisuseStackTest(StackTestCase):
             self.assertEqual(r.returncode, 2, (extra, r.stdout, r.stderr))
             self.assertIn(message, r.stderr)
         self.assertFalse(Path("/dev/shm/mft-chain-x").exists())
-        before = {p.name for p in Path("/dev/shm").glob("mft-chain-*")}
+        # Only this stack's domain: /dev/shm is shared, and another test's stack may start meanwhile.
+        mine = f"mft-chain-d{DOMAIN_BASE + 2}-*"
+        before = {p.name for p in Path("/dev/shm").glob(mine)}
         code, summary, err = self.stacks.run_json("stand.yaml", DOMAIN_BASE + 2, timeout=240)
         self.assertEqual(code, 0, err[-2000:])
         self.assertEqual(summary["chain_transport"], "shm")
         self.assertGreater(summary["ticks"], 0)
-        self.assertEqual({p.name for p in Path("/dev/shm").glob("mft-chain-*")} - before, set(),
+        self.assertEqual({p.name for p in Path("/dev/shm").glob(mine)} - before, set(),
                          "the stack left its chain segment behind")
         # A stack whose simulator never attached (it exits at once after passing its configuration check): the
         # other three opened the segment; the supervisor removes it.

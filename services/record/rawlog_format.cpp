@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -124,7 +125,13 @@ mrpt::Clock::time_point toMrptTime(std::int64_t unix_ns) {
   return mrpt::Clock::time_point(mrpt::Clock::duration(unix_ns / 100 + kFiletimeUnixOffset100ns));
 }
 std::int64_t fromMrptTime(mrpt::Clock::time_point t) {
-  return (static_cast<std::int64_t>(t.time_since_epoch().count()) - kFiletimeUnixOffset100ns) * 100;
+  // A corrupt file's timestamp may be any 64-bit count: saturate instead of overflowing (undefined).
+  const auto ticks = static_cast<std::int64_t>(t.time_since_epoch().count());
+  std::int64_t since_unix = 0, ns = 0;
+  if (__builtin_sub_overflow(ticks, kFiletimeUnixOffset100ns, &since_unix) || __builtin_mul_overflow(since_unix, 100, &ns))
+    return (ticks < kFiletimeUnixOffset100ns) ? std::numeric_limits<std::int64_t>::min()
+                                                : std::numeric_limits<std::int64_t>::max();
+  return ns;
 }
 
 ObservationEncoder::ObservationEncoder() {

@@ -2,8 +2,10 @@
 
 #include <array>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -50,18 +52,30 @@ double loadDouble(const Field& f, const void* base, std::size_t i) {
   return 0.0;
 }
 
-// As the schema-1 tables did: a cast to the member's type (flags: != 0).
+// A double read from a file into an integer member: a plain cast is undefined outside the type's range (a
+// uint64 near 2^64 comes back from its double as 2^64, and a corrupt file may hold anything), so it saturates.
+template <class T>
+T saturatingCast(double v) {
+  if (std::isnan(v)) return T{0};
+  constexpr double lo = static_cast<double>(std::numeric_limits<T>::lowest());
+  constexpr double hi = static_cast<double>(std::numeric_limits<T>::max());  // 2^63 or 2^64: rounded up
+  if (v <= lo) return std::numeric_limits<T>::lowest();
+  if (v >= hi) return std::numeric_limits<T>::max();
+  return static_cast<T>(v);
+}
+
+// As the schema-1 tables did: a cast to the member's type (flags: != 0), saturated at its range.
 void storeDouble(const Field& f, void* base, std::size_t i, double v) {
   switch (f.kind) {
     case Kind::Bool: return setElement<bool>(base, i, v != 0.0);
-    case Kind::Octet: return setElement(base, i, static_cast<std::uint8_t>(v));
-    case Kind::Char: return setElement(base, i, static_cast<char>(v));
-    case Kind::Int16: return setElement(base, i, static_cast<std::int16_t>(v));
-    case Kind::UInt16: return setElement(base, i, static_cast<std::uint16_t>(v));
-    case Kind::Int32: return setElement(base, i, static_cast<std::int32_t>(v));
-    case Kind::UInt32: return setElement(base, i, static_cast<std::uint32_t>(v));
-    case Kind::Int64: return setElement(base, i, static_cast<std::int64_t>(v));
-    case Kind::UInt64: return setElement(base, i, static_cast<std::uint64_t>(v));
+    case Kind::Octet: return setElement(base, i, saturatingCast<std::uint8_t>(v));
+    case Kind::Char: return setElement(base, i, saturatingCast<char>(v));
+    case Kind::Int16: return setElement(base, i, saturatingCast<std::int16_t>(v));
+    case Kind::UInt16: return setElement(base, i, saturatingCast<std::uint16_t>(v));
+    case Kind::Int32: return setElement(base, i, saturatingCast<std::int32_t>(v));
+    case Kind::UInt32: return setElement(base, i, saturatingCast<std::uint32_t>(v));
+    case Kind::Int64: return setElement(base, i, saturatingCast<std::int64_t>(v));
+    case Kind::UInt64: return setElement(base, i, saturatingCast<std::uint64_t>(v));
     case Kind::Float: return setElement(base, i, static_cast<float>(v));
     case Kind::Double: return setElement(base, i, v);
   }

@@ -21,8 +21,10 @@
 #include <mrpt/obs/CObservationRawDAQ.h>
 #include <random>
 #include <set>
+#include <type_traits>
 
 #include "idl/msg_pubsub.hpp"
+#include "services/record/rawlog_layout.hpp"
 #include "services/record/rawlog_reader.hpp"
 #include "services/record/recorder.hpp"
 #include "tests/rawlog/rawlog_fixture.hpp"
@@ -806,4 +808,41 @@ TEST(RawlogFormat, EveryLabelReadsBackWhatItWrote) {
       EXPECT_EQ(a, b) << labels()[static_cast<std::size_t>(li)].label;
     }
   }
+}
+
+// Found by fuzzing (dds_sample, rawlog): a file's value out of an integer member's range, or a timestamp far from
+// 1970, made the decoding's casts and arithmetic undefined. They saturate now.
+TEST(RawlogBadInput, OutOfRangeTimestampsSaturate) {
+  using Ticks = mrpt::Clock::duration;
+  EXPECT_EQ(fromMrptTime(mrpt::Clock::time_point(Ticks(std::numeric_limits<Ticks::rep>::max()))),
+            std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(fromMrptTime(mrpt::Clock::time_point(Ticks(std::numeric_limits<Ticks::rep>::min()))),
+            std::numeric_limits<std::int64_t>::min());
+}
+
+TEST(RawlogBadInput, OutOfRangeValuesOfIntegerFieldsSaturate) {
+  msg::Disturbance d;
+  d.seq(4), d.impulse(5.0), d.trigger(1), d.time_s(2.5), d.leg(1);
+  ObservationEncoder enc;
+  const int field = rawlog::layout::fieldIndex(Topic::Disturbance, "leg");
+  ASSERT_GE(field, 0);
+  for (int li : enc.encode(Message(d), 1'000'000)) {
+    const auto& l = rawlog::layout::table()[static_cast<std::size_t>(li)];  // the encoder's observations follow it
+    for (std::size_t c = 0; c < l.channels.size(); ++c) {
+      if (l.cls != LabelClass::RawDaq || l.channels[c].field != field) continue;
+      auto o = dynamic_cast<const mrpt::obs::CObservationRawDAQ&>(enc.observation(li));
+      o.AIN_32bits.clear();  // a file without exact copies: the doubles are read
+      using Leg = std::decay_t<decltype(d.leg())>;
+      for (const auto& [value, expected] : {std::pair{1e30, std::numeric_limits<Leg>::max()},
+                                            std::pair{-1e30, std::numeric_limits<Leg>::lowest()},
+                                            std::pair{std::nan(""), static_cast<Leg>(0)}}) {
+        o.AIN_double[c] = value;
+        Message back{msg::Disturbance{}};
+        ASSERT_TRUE(rawlog::layout::read(l, o, &back)) << l.label;
+        EXPECT_EQ(std::get<msg::Disturbance>(back).leg(), expected) << value;
+      }
+      return;
+    }
+  }
+  FAIL() << "no RawDAQ channel holds Disturbance.leg";
 }

@@ -6,6 +6,7 @@ in the order of the files and lines. Execution rates depend on the machine's loa
 1-minute load average at the run's start and end and the commit it fuzzed."""
 import argparse
 import json
+import re
 import sys
 
 
@@ -29,7 +30,8 @@ def grouped(x):
 
 def row(r):
     rate = r["executions"] / r["seconds"] if r["seconds"] else 0.0
-    found = "none" if not r["crashers"] and not r["finding"] else f"{r['crashers']} crasher(s): {r['finding']}"
+    finding = re.sub(r"(?<![\w.])/\S*/", "", r["finding"])  # the source file's name, not the fuzzing checkout's path
+    found = "none" if not r["crashers"] and not r["finding"] else f"{r['crashers']} crasher(s): {finding}"
     return (f"| `{r['target']}` | {r['seconds']} | {grouped(r['executions'])} | {grouped(rate)} | {r['corpus']} | "
             f"{r['cov']} / {r['ft']} | {found} | {r['commit']} | {r['started_utc']} | "
             f"{r['load_1min_start']:.1f} → {r['load_1min_end']:.1f} on {r['cores']} |")

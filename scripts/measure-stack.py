@@ -105,7 +105,7 @@ def run_stack(args, tmp, scenario, mode, tag, extra=(), record=False, hops=False
         rawlog.unlink()
     sim = dict(summary["services"]["mft-sim"])
     for key in ("deadline_misses", "deadline_misses_by_service", "sensor_to_command_latency_us", "wbc_tick_us",
-                "chain_cpu", "chain_transport"):
+                "chain_cpu", "chain_transport", "rt_priorities", "rt_threads"):
         sim["run_" + key] = summary.get(key)  # the supervisor's figures over every service
     if hops:
         sim["hop_table"] = hop_table_module().hop_table(run_dir, realtime=(mode == "realtime"))
@@ -195,6 +195,7 @@ def measure(args, tmp):
         out["realtime"] = {"sim_s": s["sim_time_s"], "deadline_misses": s["run_deadline_misses"],
                            "sensor_to_command_latency_us": s["run_sensor_to_command_latency_us"],
                            "wbc_tick_us": s["run_wbc_tick_us"], "fell": s["fell"], "chain_cpu": s["run_chain_cpu"],
+                           "rt_priorities": s["run_rt_priorities"], "rt_threads": s["run_rt_threads"],
                            "sim_wakeup_late_us": s.get("sim_wakeup_late_us"),
                            # the simulator's watchdog misses (a tick > 3 ms without its command), and with
                            # --stall-probe which of them fell in a stall of the machine

@@ -166,12 +166,15 @@ def rt_priorities_for(args, pinned_shm_chain):
 
 def realtime_options(name, args, priorities):
     """The options of service `name` for the realtime knobs: --rt-priority with priorities "chain" (from
-    rt_priorities_for), mft-sim's --spin-us with --sim-spin-us; nothing in lockstep or without --rt."""
+    rt_priorities_for), the chain services' --rt-threads, mft-sim's --spin-us with --sim-spin-us; nothing in
+    lockstep or without --rt."""
     if args.mode != "realtime" or getattr(args, "no_rt", False):
         return []
     extra = []
     if priorities == "chain" and name in RT_CHAIN_PRIORITIES:
         extra += ["--rt-priority", str(RT_CHAIN_PRIORITIES[name])]
+    if name in RT_CHAIN_PRIORITIES:
+        extra += ["--rt-threads", getattr(args, "rt_threads", None) or "loop"]  # applies on the chain channel only
     if name == "mft-sim" and getattr(args, "sim_spin_us", 0):
         extra += ["--spin-us", str(args.sim_spin_us)]
     return extra

@@ -73,6 +73,15 @@ def deadline_misses_by_service(stack):
     return out
 
 
+def rt_threads(stack):
+    """Which threads of the chain ran SCHED_FIFO in realtime: "loop" (the 1 kHz threads only: the chain channel),
+    "all" (every thread: a DDS chain, or --rt-threads all); None in lockstep or with --no-rt."""
+    args = stack.args
+    if args.mode != "realtime" or getattr(args, "no_rt", False):
+        return None
+    return (getattr(args, "rt_threads", None) or "loop") if getattr(stack, "chain_shm", None) else "all"
+
+
 def build_summary(stack, wall_s, error):
     sim = stack.services["mft-sim"].summary() or {}
     wbc = (stack.services["mft-wbc"].summary() if "mft-wbc" in stack.services else None) or {}
@@ -83,6 +92,7 @@ def build_summary(stack, wall_s, error):
         "secure": bool(getattr(stack.args, "secure", None)), "chain_cpu": getattr(stack, "chain_cpu", None),
         "chain_transport": "shm" if getattr(stack, "chain_shm", None) else "dds",
         "rt_priorities": getattr(stack, "rt_priorities", None) if stack.args.mode == "realtime" else None,
+        "rt_threads": rt_threads(stack),
         "stack": dict(stack.stack.describe(), services=stack.hosts(), only_host=stack.only_host) if stack.stack else None,
         "fell": sim.get("fell"), "sim_time_s": sim.get("sim_time_s"), "wall_time_s": round(wall_s, 3),
         "ticks": sim.get("ticks"), "real_time_factor": None,

@@ -1,4 +1,5 @@
 #include "services/runtime/chain_channel.hpp"
+#include "services/runtime/process.hpp"
 
 #include <fcntl.h>
 #include <linux/futex.h>
@@ -258,6 +259,7 @@ bool ChainSlotReader::awaitNew(std::chrono::nanoseconds timeout) {
 }
 
 void ChainSlotReader::run() {
+  enterLoopThread();  // a 1 kHz thread of the chain (realtime: SCHED_FIFO on the chain's core; else nothing)
   const timespec poll_stop{0, 100 * 1000 * 1000};  // the longest a stopping reader sleeps on
   while (!stop_.load(std::memory_order_relaxed)) {
     const std::uint32_t head = slot_.head.load(std::memory_order_acquire);

@@ -1,8 +1,11 @@
 #include "services/runtime/process.hpp"
 
+#include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 #include <sys/mman.h>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
@@ -41,6 +44,32 @@ namespace {
   for (std::size_t i = 0; i < kBytes; i += 4096) stack[i] = 0;
   asm volatile("" : : "r"(stack) : "memory");  // keeps the writes: the compiler must assume the array is read
 }
+
+struct LoopPlacement {
+  std::atomic<bool> configured{false};
+  int priority = 0;
+  cpu_set_t cpus{};
+};
+LoopPlacement g_loop;
+
+bool lockAndPrefault() {
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    std::fprintf(stderr, "warning: mlockall failed (%s): continuing without locked memory\n", std::strerror(errno));
+    return false;
+  }
+  prefaultStack();
+  return true;
+}
+
+// The machine's online CPUs outside `loop` (empty when the process may run everywhere).
+cpu_set_t cpusOutside(const cpu_set_t& loop) {
+  cpu_set_t others;
+  CPU_ZERO(&others);
+  const long online = sysconf(_SC_NPROCESSORS_ONLN);
+  for (long c = 0; c < online && c < CPU_SETSIZE; ++c)
+    if (!CPU_ISSET(c, &loop)) CPU_SET(c, &others);
+  return others;
+}
 }  // namespace
 
 bool tryRealtimeScheduling(int priority) {
@@ -51,13 +80,32 @@ bool tryRealtimeScheduling(int priority) {
     std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): running at normal priority\n", std::strerror(errno));
     ok = false;
   }
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
-    std::fprintf(stderr, "warning: mlockall failed (%s): continuing without locked memory\n", std::strerror(errno));
-    ok = false;
-  } else {
-    prefaultStack();
+  return lockAndPrefault() && ok;
+}
+
+bool tryRealtimeLoopThreads(int priority) {
+  bool ok = lockAndPrefault();
+  if (sched_getaffinity(0, sizeof(g_loop.cpus), &g_loop.cpus) != 0) {
+    std::fprintf(stderr, "warning: sched_getaffinity failed (%s): every thread realtime\n", std::strerror(errno));
+    return tryRealtimeScheduling(priority) && ok;
   }
+  g_loop.priority = priority;
+  g_loop.configured = true;
+  const cpu_set_t others = cpusOutside(g_loop.cpus);
+  // A cpuset cgroup may forbid the other CPUs: the housekeeping threads then stay beside the loop, SCHED_OTHER.
+  if (CPU_COUNT(&others) > 0) sched_setaffinity(0, sizeof(others), &others);
   return ok;
+}
+
+void enterLoopThread() {
+  if (!g_loop.configured.load()) return;
+  static std::atomic<bool> warned{false};
+  pthread_setaffinity_np(pthread_self(), sizeof(g_loop.cpus), &g_loop.cpus);
+  sched_param sp{};
+  sp.sched_priority = g_loop.priority;
+  const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+  if (rc != 0 && !warned.exchange(true))
+    std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): the loop runs at normal priority\n", std::strerror(rc));
 }
 
 void announceReady(const std::string& service) {

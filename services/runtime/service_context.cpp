@@ -18,6 +18,9 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
   cli.option("rt-priority", "with --rt: the SCHED_FIFO priority (the supervisor's --rt-priorities chain gives the chain's "
              "services rising priorities along the chain)", "80");
+  cli.option("rt-threads", "with --rt and --chain-shm: loop (only the 1 kHz threads take SCHED_FIFO, on the CPUs the "
+             "service was started on; DDS's own threads stay SCHED_OTHER on the other CPUs) or all (every thread "
+             "SCHED_FIFO, as with a DDS chain); docs/results/loop-benchmark.md", "loop");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "
              "comma list; docs/guide/profiles.md)");
@@ -68,7 +71,14 @@ ServiceContext::ServiceContext(const std::string& service, const CommandLine& cl
   const std::string chain_shm = cli.get("chain-shm");
   if (!chain_shm.empty() && !cli.get("secure").empty())
     cli.fail("--chain-shm: not with --secure (it would bypass DDS access control)");
-  if (cli.isSet("rt")) tryRealtimeScheduling(static_cast<int>(cli.getInt("rt-priority", 1, 98)));
+  const std::string rt_threads = cli.get("rt-threads");
+  if (rt_threads != "loop" && rt_threads != "all") cli.fail("--rt-threads: expected loop or all, got '" + rt_threads + "'");
+  if (cli.isSet("rt")) {
+    const int priority = static_cast<int>(cli.getInt("rt-priority", 1, 98));
+    // On a DDS chain the 1 kHz work runs on DDS's threads: they must inherit SCHED_FIFO.
+    if (rt_threads == "loop" && !chain_shm.empty()) tryRealtimeLoopThreads(priority);
+    else tryRealtimeScheduling(priority);
+  }
   try {
     participant_ = std::make_unique<DdsParticipant>(domain, profilesFile(cli), service,
                                                     SecurityOptions{cli.get("secure"), securityIdentity(service)},

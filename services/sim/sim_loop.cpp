@@ -112,6 +112,7 @@ bool SimLoop::awaitChain() {
 
 void SimLoop::run() {
   stall_probe_ = makeStallProbe(ctx_.lockstep() ? 0 : cli_.getInt("stall-probe-us", 0, 100000));
+  enterLoopThread();  // realtime on the chain channel: this thread takes SCHED_FIFO on the chain's core
   pacer_.emplace(control_period_s_, watchdog_ns_, std::chrono::microseconds(cli_.getInt("spin-us", 0, 900)));
   exchange_.emplace(ctx_.lockstep(), TickExchange::Timeouts{command_timeout_, start_timeout_, resend_}, link_,
                     recorder_, *pacer_, hops_);

@@ -71,6 +71,7 @@ class StackTest(StackTestCase):
         self.assertGreater(s["wall_time_s"], 9.9)             # it ran on the wall clock
         allowed = sorted(os.sched_getaffinity(0))            # realtime too: the chain on the CPU its domain picks
         self.assertEqual(s["chain_cpu"], allowed[(DOMAIN_BASE + 1) % len(allowed)])
+        self.assertEqual(s["rt_threads"], "loop")             # only the 1 kHz threads SCHED_FIFO on that core
         self.assertGreater(sim["latency_us"]["count"], 9000)  # nearly every command answered within its period
         print(f"\nrealtime: deadline misses {sim['deadline_misses']}, damping ticks {sim['damping_ticks']}, "
               f"latency p50 {sim['latency_us']['p50']:.0f} us p99 {sim['latency_us']['p99']:.0f} us, simulator "

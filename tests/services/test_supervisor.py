@@ -20,6 +20,7 @@ from mftstack.simlog import HELPER_FIFO_PRIORITY, helper_realtime_prefix, reserv
 from mftstack.errors import SupervisorError  # noqa: E402
 from mftstack.processes import (chain_cpu_for, chain_shm_name, cpu_placement, realtime_options,  # noqa: E402
                                  rt_priorities_for)
+from mftstack.summary import rt_threads  # noqa: E402
 from mftstack.summary import gaps_in_stalls, stalled_within  # noqa: E402
 from mftstack.testing import CONFIG, SUPERVISOR, pid_alive  # noqa: E402
 
@@ -100,10 +101,10 @@ class ChainPlacementTest(unittest.TestCase):
 
 
 class RealtimeKnobsTest(unittest.TestCase):
-    """--rt-priorities and --sim-spin-us reach the services they are for, in realtime with --rt only."""
+    """--rt-priorities, --rt-threads and --sim-spin-us reach the services they are for, in realtime with --rt only."""
 
     def args(self, **kw):
-        base = dict(mode="realtime", no_rt=False, rt_priorities=None, sim_spin_us=0)
+        base = dict(mode="realtime", no_rt=False, rt_priorities=None, sim_spin_us=0, rt_threads="loop")
         base.update(kw)
         return argparse.Namespace(**base)
 
@@ -115,7 +116,7 @@ class RealtimeKnobsTest(unittest.TestCase):
         self.assertEqual(len(set(prios)), 4)
         self.assertTrue(all(1 <= p < 80 for p in prios))  # below the stall probe and the tests' watchers (85)
         self.assertEqual(realtime_options("mft-record", args, "chain"), [])
-        self.assertEqual(realtime_options("mft-wbc", args, "flat"), [])
+        self.assertNotIn("--rt-priority", realtime_options("mft-wbc", args, "flat"))
 
     def test_the_chains_priorities_are_the_default_only_for_a_pinned_chain_on_shared_memory(self):
         self.assertEqual(rt_priorities_for(self.args(), pinned_shm_chain=True), "chain")
@@ -124,11 +125,30 @@ class RealtimeKnobsTest(unittest.TestCase):
         self.assertEqual(rt_priorities_for(self.args(rt_priorities="flat"), pinned_shm_chain=True), "flat")
 
     def test_spin_goes_to_the_simulator_alone_and_nothing_in_lockstep(self):
-        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150), "flat"), ["--spin-us", "150"])
-        self.assertEqual(realtime_options("mft-wbc", self.args(sim_spin_us=150), "flat"), [])
+        self.assertEqual(realtime_options("mft-sim", self.args(sim_spin_us=150), "flat")[-2:], ["--spin-us", "150"])
+        self.assertNotIn("--spin-us", realtime_options("mft-wbc", self.args(sim_spin_us=150), "flat"))
         self.assertEqual(realtime_options("mft-sim", self.args(mode="lockstep", sim_spin_us=150), "chain"), [])
         self.assertEqual(realtime_options("mft-sim", self.args(no_rt=True), "chain"), [])
-        self.assertEqual(realtime_options("mft-sim", self.args(), "flat"), [])
+        self.assertNotIn("--spin-us", realtime_options("mft-sim", self.args(), "flat"))
+
+    def test_rt_threads_goes_to_the_four_chain_services(self):
+        for name in ("mft-sim", "mft-estimator", "mft-planner", "mft-wbc"):
+            opts = realtime_options(name, self.args(rt_threads="all"), "flat")
+            self.assertEqual(opts[opts.index("--rt-threads") + 1], "all")
+            opts = realtime_options(name, self.args(rt_threads=None), "chain")
+            self.assertEqual(opts[opts.index("--rt-threads") + 1], "loop")  # the default
+        self.assertEqual(realtime_options("mft-record", self.args(rt_threads="all"), "flat"), [])
+        self.assertEqual(realtime_options("mft-wbc", self.args(mode="lockstep"), "flat"), [])
+
+    def test_the_summary_says_which_threads_ran_realtime(self):
+        stack = argparse.Namespace(args=self.args(), chain_shm="/mft-chain-d3")
+        self.assertEqual(rt_threads(stack), "loop")
+        stack.args.rt_threads = "all"
+        self.assertEqual(rt_threads(stack), "all")
+        stack = argparse.Namespace(args=self.args(), chain_shm=None)  # a DDS chain: its work is on DDS's threads
+        self.assertEqual(rt_threads(stack), "all")
+        self.assertIsNone(rt_threads(argparse.Namespace(args=self.args(mode="lockstep"), chain_shm="/x")))
+        self.assertIsNone(rt_threads(argparse.Namespace(args=self.args(no_rt=True), chain_shm="/x")))
 
 
 class ChainTransportTest(unittest.TestCase):

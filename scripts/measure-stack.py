@@ -218,8 +218,9 @@ def measure(args, tmp):
 def hops_against_the_floor(table, wakeup):
     """Each realtime hop that carries a sample from one process to the next, against the machine's own thread
     wake-up (mft-wakeup, same run): a hop cannot beat a wake-up, so what its p99 has over the floor is the
-    transport's own share. The realtime stack is not pinned, so a hop wakes its reader on the same core or on the
-    other one: both floors are given, and the excess is taken over the larger (cross-core on a multi-core VM)."""
+    transport's own share. A stack may run unpinned (--chain-cpu none, --stack), where a hop wakes its reader on the
+    same core or on the other one: both floors are given, and the excess is taken over the larger (cross-core on a
+    multi-core VM); a pinned chain's hops are same-core wake-ups."""
     floors = {where: w["p99"] for where, w in wakeup["wakeup_us"].items()}
     floor = max(floors.values())
     hop_table = hop_table_module()

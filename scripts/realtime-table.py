@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Markdown rows of the figures of measure-stack.py JSON files, one row per file: the realtime run's (default) or,
-with --lockstep, the lockstep rounds' (speed ratio to the in-process run, recording cost). docs/results pages quote
+with --lockstep, the lockstep rounds' (speed ratio to the in-process run, recording cost); with --stages, the
+realtime run's chain stage by stage, one column per file. docs/results pages quote
 these rows; test docs_results_pages regenerates them from the files the page cites."""
 import argparse
 import json
@@ -56,13 +57,31 @@ def lockstep_table(paths):
     return LOCKSTEP_HEADER + [lockstep_row(p) for p in paths]
 
 
+def stages_table(paths):
+    """The realtime run's chain stage by stage, one column per file: p50 / p99 of each interval of the hop table
+    (from the sensor sample leaving the simulator to the command reaching it), then the writers' own costs."""
+    runs = [json.loads(Path(p).read_text())["realtime"]["hop_table"] for p in paths]
+    head = ["| interval, p50 / p99 [µs] | " + " | ".join(Path(p).stem for p in paths) + " |",
+            "|---|" + "---|" * len(paths)]
+    rows = []
+    for key in ("intervals", "write_costs"):
+        for i, item in enumerate(runs[0][key]):
+            cells = [f"{r[key][i]['p50']:.0f} / {r[key][i]['p99']:.0f}" for r in runs]
+            rows.append(f"| {item['interval']} | " + " | ".join(cells) + " |")
+    rows.append("| sum: sensor → command | " + " | ".join(f"{r['tick_us']['p50']:.0f} / {r['tick_us']['p99']:.0f}"
+                                                           for r in runs) + " |")
+    return head + rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("files", nargs="+", help="JSON files written by scripts/measure-stack.py --json")
     ap.add_argument("--lockstep", action="store_true", help="the lockstep rounds' row instead of the realtime run's")
+    ap.add_argument("--stages", action="store_true", help="the realtime run's chain stage by stage (p50 / p99 of "
+                    "each hop-table interval), one column per file")
     a = ap.parse_args()
     try:
-        print("\n".join((lockstep_table if a.lockstep else table)(a.files)))
+        print("\n".join((lockstep_table if a.lockstep else stages_table if a.stages else table)(a.files)))
     except (OSError, ValueError, KeyError, StopIteration) as e:
         print(f"realtime-table: {e}", file=sys.stderr)
         return 2

@@ -388,10 +388,10 @@ def stack_options(sp):
                     "chain pinned to one core on the shared-memory channel) or 80 for all (flat: the default "
                     "otherwise, e.g. with --secure or --stack); docs/results/loop-benchmark.md")
     sp.add_argument("--rt-threads", choices=["loop", "all"], default="loop", help="realtime, the chain on the "
-                    "shared-memory channel: loop (the default) gives SCHED_FIFO only to the chain's 1 kHz threads, on "
-                    "the chain's core, and keeps each service's other threads (DDS's own) at normal priority on the "
-                    "other CPUs; all: every thread SCHED_FIFO (as a DDS chain always runs); "
-                    "docs/results/loop-benchmark.md")
+                    "shared-memory channel: loop (the default) gives the chain's priorities only to its 1 kHz threads, "
+                    "on the chain's core, and runs each service's other threads (DDS's own) at SCHED_FIFO 1 on the "
+                    "other CPUs; all: every thread at the service's priority on the chain's core (as a DDS chain "
+                    "always runs); docs/results/loop-benchmark.md")
     sp.add_argument("--sim-spin-us", type=spin_us, default=0, metavar="US", help="realtime: the simulator wakes this "
                     "long before each 1 kHz deadline and polls the clock to it (0..900; default 0: sleeps to it)")
     sp.add_argument("--chain-cpu", metavar="N|auto|none", help="pin the control chain (sim, estimator, planner, "

@@ -5,6 +5,7 @@
 #include <unistd.h>
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -92,8 +93,16 @@ bool tryRealtimeLoopThreads(int priority) {
   g_loop.priority = priority;
   g_loop.configured = true;
   const cpu_set_t others = cpusOutside(g_loop.cpus);
-  // A cpuset cgroup may forbid the other CPUs: the housekeeping threads then stay beside the loop, SCHED_OTHER.
+  // A cpuset cgroup may forbid the other CPUs: the housekeeping threads then stay beside the loop, below it.
   if (CPU_COUNT(&others) > 0) sched_setaffinity(0, sizeof(others), &others);
+  // SCHED_FIFO at the lowest priority: above every normal task, so that a loaded machine cannot starve a Fast DDS
+  // thread while it holds a lock a loop thread's write needs (a realtime stack fell so under load at SCHED_OTHER).
+  sched_param sp{};
+  sp.sched_priority = std::min(kHousekeepingPriority, priority);
+  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
+    std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): running at normal priority\n", std::strerror(errno));
+    ok = false;
+  }
   return ok;
 }
 

@@ -37,9 +37,11 @@ bool tryRealtimeScheduling(int priority);
 // The realtime placement of a chain service on the shared-memory channel, where the 1 kHz work runs on threads
 // the service owns: only those take SCHED_FIFO at `priority`, each as it starts (enterLoopThread()), on the CPUs
 // the process was started on (the supervisor's chain CPU). Every other thread (the main thread waiting for
-// shutdown, DDS's own threads, created after this call) stays SCHED_OTHER and leaves those CPUs when the machine
-// has others, so nothing but the chain wakes up on the chain's core (measured: docs/results/loop-benchmark.md).
-// Locks memory as tryRealtimeScheduling. Call before creating the DDS participant. Returns true when all took effect.
+// shutdown, DDS's own threads, created after this call) runs at SCHED_FIFO kHousekeepingPriority and leaves those
+// CPUs when the machine has others, so nothing but the chain wakes up on the chain's core
+// (measured: docs/results/loop-benchmark.md). Locks memory as tryRealtimeScheduling. Call before creating the DDS
+// participant. Returns true when all took effect.
+constexpr int kHousekeepingPriority = 1;
 bool tryRealtimeLoopThreads(int priority);
 // After tryRealtimeLoopThreads: the calling thread becomes a loop thread (SCHED_FIFO on the chain's CPUs);
 // otherwise it does nothing. Warns once if the scheduler refuses.

@@ -18,9 +18,9 @@ void ServiceContext::declareOptions(CommandLine& cli) {
   cli.flag("rt", "try SCHED_FIFO + mlockall (falls back with a warning)");
   cli.option("rt-priority", "with --rt: the SCHED_FIFO priority (the supervisor's --rt-priorities chain gives the chain's "
              "services rising priorities along the chain)", "80");
-  cli.option("rt-threads", "with --rt and --chain-shm: loop (only the 1 kHz threads take SCHED_FIFO, on the CPUs the "
-             "service was started on; DDS's own threads stay SCHED_OTHER on the other CPUs) or all (every thread "
-             "SCHED_FIFO, as with a DDS chain); docs/results/loop-benchmark.md", "loop");
+  cli.option("rt-threads", "with --rt and --chain-shm: loop (only the 1 kHz threads take the --rt-priority, on the CPUs "
+             "the service was started on; the other threads, DDS's own, SCHED_FIFO 1 on the other CPUs) or all (every "
+             "thread at the --rt-priority, as with a DDS chain); docs/results/loop-benchmark.md", "loop");
   cli.option("secure", "DDS Security: the directory made by scripts/make-security.sh (this service's identity)");
   cli.option("profile", "configuration profile config/profiles/NAME.yaml, after the scenario's (repeatable, or a "
              "comma list; docs/guide/profiles.md)");

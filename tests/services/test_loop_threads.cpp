@@ -1,6 +1,7 @@
 // The realtime placement of a chain service's threads (services/runtime/process.hpp): in a process confined to
-// one CPU, after tryRealtimeLoopThreads the threads it starts stay SCHED_OTHER and leave that CPU, and a thread
-// that calls enterLoopThread returns to it with SCHED_FIFO (when the scheduler permits SCHED_FIFO at all).
+// one CPU, after tryRealtimeLoopThreads the threads it starts leave that CPU at the housekeeping priority
+// (SCHED_FIFO 1), and a thread that calls enterLoopThread returns to it at the loop's priority (when the
+// scheduler permits SCHED_FIFO at all; otherwise every thread keeps SCHED_OTHER).
 // Each case runs in a forked child: the placement is process-wide.
 #include <gtest/gtest.h>
 #include <pthread.h>
@@ -58,7 +59,7 @@ int firstAllowedCpu() {
 }
 }  // namespace
 
-TEST(LoopThreads, OnlyTheLoopThreadsStayOnTheChainCpuAndTakeSchedFifo) {
+TEST(LoopThreads, OnlyTheLoopThreadsRunOnTheChainCpuAtTheLoopPriority) {
   const int chain_cpu = firstAllowedCpu();
   if (chain_cpu < 0) GTEST_SKIP() << "needs two CPUs this process may run on";
   mft::test::ForkedChild child([chain_cpu]() -> std::string {
@@ -73,7 +74,9 @@ TEST(LoopThreads, OnlyTheLoopThreadsStayOnTheChainCpuAndTakeSchedFifo) {
     const Placement loop = placementOfNewThread(true);
     if (CPU_ISSET(chain_cpu, &main_thread.cpus) || CPU_COUNT(&main_thread.cpus) < 1) return "the main thread stayed";
     if (CPU_ISSET(chain_cpu, &other.cpus)) return "a thread started afterwards runs on the chain's CPU";
-    if (other.policy != SCHED_OTHER) return "a thread started afterwards is not SCHED_OTHER";
+    if (fifo && (other.policy != SCHED_FIFO || other.priority != mft::services::kHousekeepingPriority))
+      return "a thread started afterwards is not at the housekeeping priority";
+    if (!fifo && other.policy != SCHED_OTHER) return "SCHED_FIFO refused, yet a thread's policy changed";
     if (CPU_COUNT(&loop.cpus) != 1 || !CPU_ISSET(chain_cpu, &loop.cpus)) return "the loop thread left the chain's CPU";
     if (fifo && (loop.policy != SCHED_FIFO || loop.priority != 42)) return "the loop thread is not SCHED_FIFO 42";
     if (!fifo && loop.policy != SCHED_OTHER) return "SCHED_FIFO refused, yet the loop thread's policy changed";

@@ -129,7 +129,7 @@ def check_page(page, docs):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--docs", default=str(ROOT / "docs"), help="the docs folder (default: the repository's)")
-    ap.add_argument("--page", action="append", help="check this page only (path; repeatable)")
+    ap.add_argument("--page", nargs="+", action="extend", help="check these pages only (paths)")
     ap.add_argument("--json", action="store_true", help="print the problems as JSON")
     a = ap.parse_args()
     docs = Path(a.docs)

@@ -15,7 +15,8 @@ Not figures: numbers in `code` and code blocks, ordered lists' markers, link tar
 "Table II", "Fig. 6", "eq. 13", "2-vCPU". Any other number outside those two places is reported as unquoted.
 
 The default checks docs/results/*.md and exits 1 listing every figure not found and every unquoted one, as the
-test docs_results_pages does; `--page` checks one page."""
+test docs_results_pages does; `--page` checks the pages given (the test checks the README's quoted passages with
+`--quoted-only`)."""
 import argparse
 import json
 import re
@@ -104,8 +105,9 @@ def found(value, decimals, pool):
     return any(abs(v * s - value) <= tolerance for v in pool for s in SCALES)
 
 
-def check_page(page, docs):
-    """Problems of PAGE: (kind, passage start, figure) for figures not found in their files and unquoted ones."""
+def check_page(page, docs, unquoted=True):
+    """Problems of PAGE: (kind, where, figure) for figures not found in their files and (with UNQUOTED) figures
+    outside generated blocks and quoted passages."""
     text = page.read_text()
     problems = []
     for m in QUOTES.finditer(text):
@@ -119,6 +121,8 @@ def check_page(page, docs):
         for printed, value, decimals in figures(m.group(2)):
             if not found(value, decimals, pool):
                 problems.append(("not in its files", f"line {line}: {m.group(1)}", printed))
+    if not unquoted:
+        return problems
     rest = QUOTES.sub("", GENERATED.sub("", text))
     for ln in prose(rest).splitlines():
         for m in NUMBER.finditer(ln):
@@ -130,12 +134,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--docs", default=str(ROOT / "docs"), help="the docs folder (default: the repository's)")
     ap.add_argument("--page", nargs="+", action="extend", help="check these pages only (paths)")
+    ap.add_argument("--quoted-only", action="store_true",
+                    help="check the quoted passages only, not the figures outside them (a page that is not a results page)")
     ap.add_argument("--json", action="store_true", help="print the problems as JSON")
     a = ap.parse_args()
     docs = Path(a.docs)
     pages = [Path(p) for p in a.page] if a.page else sorted((docs / "results").glob("*.md"))
     try:
-        problems = {str(p.name): check_page(p, docs) for p in pages}
+        problems = {str(p.name): check_page(p, docs, not a.quoted_only) for p in pages}
     except (OSError, ValueError) as e:
         print(f"quoted-figures: {e}", file=sys.stderr)
         return 2

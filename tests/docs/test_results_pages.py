@@ -2,13 +2,16 @@
 
 Every generated block (`<!-- generated: KIND FILE ... -->`) is what its files give, by the renderer
 `scripts/results-blocks.py` names for KIND (the tool that measured them). Also: the README's Table II, and the stack
-Table II the recovery map prints beside its lift-off column, are the push sweep's of the table-ii block.
+Table II the recovery map prints beside its lift-off column, are the push sweep's of the table-ii block. And every
+figure in a results page's prose, and in the README's quoted passages, is in the file its passage quotes
+(`scripts/quoted-figures.py`).
 """
 import argparse
 import importlib.util
 import json
 import pathlib
 import sys
+import tempfile
 import unittest
 
 from readme_tables import readme_table_ii
@@ -32,6 +35,7 @@ class ResultsPages(unittest.TestCase):
         cls.recovery_report = recovery_report
         cls.results = load_module(cls.root / "scripts" / "results-blocks.py", "results_blocks")
         cls.blocks = cls.results.blocks(cls.root / "docs")
+        cls.quoted = load_module(cls.root / "scripts" / "quoted-figures.py", "quoted_figures")
 
     def test_every_generated_block_is_what_its_files_give(self):
         kinds = {kind for _, kind, _, _ in self.blocks}
@@ -51,6 +55,30 @@ class ResultsPages(unittest.TestCase):
         self.assertEqual(readme_table_ii(self.root), sweep)
         for c in ("sa", "mft"):
             self.assertEqual(self.recovery_report.STACK_TABLE2[c], {h: v[c] for h, v in sweep.items()})
+
+    def test_every_figure_of_a_results_page_is_in_the_file_it_quotes(self):
+        pages = sorted((self.root / "docs" / "results").glob("*.md"))
+        self.assertGreaterEqual(len(pages), 8)
+        for page in pages:
+            with self.subTest(page=page.name):
+                self.assertEqual(self.quoted.check_page(page, self.root / "docs"), [])
+
+    def test_the_readmes_quoted_figures_are_in_their_files(self):
+        readme = self.root / "README.md"
+        self.assertIn("<!-- quotes: results/data/push-sweep", readme.read_text())
+        self.assertEqual(self.quoted.check_page(readme, self.root / "docs", unquoted=False), [])
+
+    def test_the_figure_check_finds_a_misquote_and_an_unquoted_figure(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            docs = pathlib.Path(tmp)
+            (docs / "data.json").write_text(json.dumps({"i_max_Ns": 12.66, "why": "fell at 6.473 s", "frac": 0.252}))
+            page = docs / "page.md"
+            page.write_text("## Fig. 6 on 2026-11-28 at bcfa0af\n<!-- quotes: data.json -->\n"
+                            "Recovers up to 12.7 N s (`--start 12.0`), falls at 6.47 s, +25.2 %; 12.6 is wrong.\n"
+                            "<!-- end quotes -->\nLoose 3.3 here.\n")
+            problems = self.quoted.check_page(page, docs)
+        self.assertEqual([(kind, figure) for kind, _, figure in problems],
+                         [("not in its files", "12.6"), ("unquoted", "3.3")])
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser()

@@ -28,7 +28,7 @@ QUOTES = re.compile(r"<!-- quotes: ([^>]+?) -->\n(.*?)<!-- end quotes -->", re.S
 GENERATED = re.compile(r"<!-- generated: [^>]+? -->\n.*?<!-- end generated -->", re.S)
 FENCE = re.compile(r"^[ \t]*```.*?^[ \t]*```", re.S | re.M)
 LIST_MARKER = re.compile(r"^\s*\d+\.\s", re.M)
-NUMBER = re.compile(r"(?<![\w.])\d+(?:,\d{3})*(?:\.\d+)?(?:e[−-]?\d+)?(?![\w])")
+NUMBER = re.compile(r"(?<![\w.])\d+(?:,\d{3})*(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w])")
 NOT_FIGURES = [
     re.compile(r"`[^`]*`"),                                  # code: commands, paths, options
     re.compile(r"\]\([^)]*\)"),                              # link targets

@@ -71,16 +71,18 @@ cpu_set_t cpusOutside(const cpu_set_t& loop) {
     if (!CPU_ISSET(c, &loop)) CPU_SET(c, &others);
   return others;
 }
+// The calling thread, and the threads it creates later, at SCHED_FIFO PRIORITY; a warning if not permitted.
+bool setFifo(int priority) {
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (sched_setscheduler(0, SCHED_FIFO, &sp) == 0) return true;
+  std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): running at normal priority\n", std::strerror(errno));
+  return false;
+}
 }  // namespace
 
 bool tryRealtimeScheduling(int priority) {
-  bool ok = true;
-  sched_param sp{};
-  sp.sched_priority = priority;
-  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
-    std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): running at normal priority\n", std::strerror(errno));
-    ok = false;
-  }
+  const bool ok = setFifo(priority);
   return lockAndPrefault() && ok;
 }
 
@@ -97,13 +99,7 @@ bool tryRealtimeLoopThreads(int priority) {
   if (CPU_COUNT(&others) > 0) sched_setaffinity(0, sizeof(others), &others);
   // SCHED_FIFO at the lowest priority: above every normal task, so that a loaded machine cannot starve a Fast DDS
   // thread while it holds a lock a loop thread's write needs (a realtime stack fell so under load at SCHED_OTHER).
-  sched_param sp{};
-  sp.sched_priority = std::min(kHousekeepingPriority, priority);
-  if (sched_setscheduler(0, SCHED_FIFO, &sp) != 0) {
-    std::fprintf(stderr, "warning: SCHED_FIFO not permitted (%s): running at normal priority\n", std::strerror(errno));
-    ok = false;
-  }
-  return ok;
+  return setFifo(std::min(kHousekeepingPriority, priority)) && ok;
 }
 
 void enterLoopThread() {

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Markdown rows of the figures of measure-stack.py JSON files, one row per file: the realtime run's (default) or,
 with --lockstep, the lockstep rounds' (speed ratio to the in-process run, recording cost); with --stages, the
-realtime run's chain stage by stage, one column per file. docs/results pages quote
+realtime run's chain stage by stage, one column per file; with --targets, the realtime targets and how many of the
+runs met each. docs/results pages quote
 these rows; test docs_results_pages regenerates them from the files the page cites."""
 import argparse
 import json
@@ -73,15 +74,56 @@ def stages_table(paths):
     return head + rows
 
 
+# The realtime loop's targets: the chain's sensor-to-command p99 close to the machine's own floor (the timer lateness
+# of the chain's CPU in the same run) or small outright, and the WBC's tick not inflated by running in realtime.
+TARGET_P99_US = 250.0
+TARGET_P99_OVER_TIMER_US = 150.0
+TARGET_WBC_TICK_RATIO = 2.0
+
+
+def target_figures(path):
+    """(p99, p99 over the chain CPU's timer p99, WBC tick p99 realtime / lockstep, misses, misses outside a stall)."""
+    d = json.loads(Path(path).read_text())
+    rt = d["realtime"]
+    lock = next(iter(d["lockstep"].values()))
+    wbc_lock = next(i for i in lock["hop_table"]["intervals"] if i["interval"] == "WBC compute")["p99"]
+    late = d["machine_wakeup"]["timer_late_us"]
+    cpu = rt.get("chain_cpu")
+    timer = late[f"cpu{cpu}"]["p99"] if cpu is not None else max(v["p99"] for v in late.values())
+    p99 = rt["sensor_to_command_latency_us"]["p99"]
+    return p99, p99 - timer, rt["wbc_tick_us"]["p99"] / wbc_lock, rt["sim_deadline_misses"], rt["sim_misses_unexplained"]
+
+
+def targets_table(paths):
+    """The targets, and per target how many of the runs in PATHS met it, with the range of the figure."""
+    runs = {Path(p).stem: target_figures(p) for p in paths}
+    latency_met = [n for n, f in runs.items() if f[0] <= TARGET_P99_US or f[1] <= TARGET_P99_OVER_TIMER_US]
+    wbc_met = [n for n, f in runs.items() if f[2] <= TARGET_WBC_TICK_RATIO]
+    missed = [n for n in runs if n not in wbc_met]
+    span = lambda i, fmt: f"{fmt.format(min(f[i] for f in runs.values()))}–{fmt.format(max(f[i] for f in runs.values()))}"
+    return ["| target | runs that met it |", "|---|---|",
+            f"| sensor → command p99 at most {TARGET_P99_US:.0f} µs, or at most {TARGET_P99_OVER_TIMER_US:.0f} µs above "
+            f"the timer lateness p99 of the chain's CPU in the same run | {len(latency_met)} of {len(runs)} (p99 "
+            f"{span(0, '{:.0f}')} µs; over the timer's {span(1, '{:+.0f}')} µs) |",
+            f"| the WBC's tick p99 in realtime at most {TARGET_WBC_TICK_RATIO:g} times its lockstep p99 | "
+            f"{len(wbc_met)} of {len(runs)} (ratio {span(2, '{:.2f}')}" + (f"; not met: {', '.join(missed)}" if missed
+                                                                            else "") + ") |",
+            f"| (no target) simulator deadline misses, told apart by the stall probe | "
+            f"{sum(f[3] for f in runs.values())} in all, {sum(f[4] for f in runs.values())} of them not in a CPU "
+            f"stall |"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("files", nargs="+", help="JSON files written by scripts/measure-stack.py --json")
     ap.add_argument("--lockstep", action="store_true", help="the lockstep rounds' row instead of the realtime run's")
     ap.add_argument("--stages", action="store_true", help="the realtime run's chain stage by stage (p50 / p99 of "
                     "each hop-table interval), one column per file")
+    ap.add_argument("--targets", action="store_true", help="the realtime targets and how many of the runs met each")
     a = ap.parse_args()
+    kind = lockstep_table if a.lockstep else stages_table if a.stages else targets_table if a.targets else table
     try:
-        print("\n".join((lockstep_table if a.lockstep else stages_table if a.stages else table)(a.files)))
+        print("\n".join(kind(a.files)))
     except (OSError, ValueError, KeyError, StopIteration) as e:
         print(f"realtime-table: {e}", file=sys.stderr)
         return 2

@@ -10,6 +10,7 @@ A page marks a block with
   realtime      the rows `scripts/realtime-table.py` makes of measure-stack.py JSON files
   lockstep      the rows `scripts/realtime-table.py --lockstep` makes of measure-stack.py JSON files
   realtime-stages  the table `scripts/realtime-table.py --stages` makes of measure-stack.py JSON files
+  realtime-targets the targets table `scripts/realtime-table.py --targets` makes of measure-stack.py JSON files
   speed         the table `scripts/speed-table.py` makes of mft-qp bench, mft-bench and mft-wakeup JSON files
   fault-matrix  every line `scripts/fault-matrix.py` writes to fault-matrix.md (fault-matrix.json)
   terrain-scan  the heights x speeds grid of `mft-experiment terrain-scan`'s terrain_scan.json
@@ -56,6 +57,8 @@ def render(kind, paths):
         return load_script("realtime-table").lockstep_table([str(p) for p in paths])
     if kind == "realtime-stages":
         return load_script("realtime-table").stages_table([str(p) for p in paths])
+    if kind == "realtime-targets":
+        return load_script("realtime-table").targets_table([str(p) for p in paths])
     if kind == "speed":
         return load_script("speed-table").table([str(p) for p in paths])
     if kind == "fault-matrix":

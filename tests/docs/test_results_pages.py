@@ -40,7 +40,7 @@ class ResultsPages(unittest.TestCase):
     def test_every_generated_block_is_what_its_files_give(self):
         kinds = {kind for _, kind, _, _ in self.blocks}
         self.assertTrue({"recovery-map", "realtime", "table-ii", "ablation", "lockstep", "speed", "fault-matrix",
-                         "terrain-scan", "fuzzing"} <= kinds,
+                         "terrain-scan", "fuzzing", "realtime-targets"} <= kinds,
                         kinds)
         for page, kind, files, body in self.blocks:
             with self.subTest(page=page.name, files=files):

@@ -28,7 +28,7 @@ def add_parser(sub, heights_list, controllers_list, positive, add_common, add_di
     r = sub.add_parser("recovery-map", help="recovery probability over impulse, gait phase and direction",
                        description=_map.__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     r.add_argument("--heights", type=heights_list, default=[0.44],
-                   help="reference base heights [m] (default 0.44: 2391 runs, about 16 CPU-minutes; docs/results/recovery-map.md)")
+                   help="reference base heights [m] (default 0.44: 2391 runs; cost: docs/results/recovery-map.md)")
     r.add_argument("--controllers", type=controllers_list, default=["sa", "mft"], help="default sa,mft")
     r.add_argument("--directions", type=directions_list, default=list(_map.DIRECTIONS), help="default forward,backward")
     r.add_argument("--phases", type=bounded(int, 1, 64, "--phases must be 1..64: {v}"), metavar="N", default=8, help="push phases per gait cycle (default 8, at least 8)")

@@ -1,6 +1,7 @@
 """The documentation site and the pages it is made of.
 
-- `mkdocs build --strict` succeeds and writes a page for every entry of the navigation;
+- `mkdocs build --strict` succeeds and writes a page for every entry of the navigation, where every Markdown table
+  became a table (a stray `|` in a cell leaves it a paragraph of pipes);
 - every Markdown file under docs/ is in the navigation (none left out);
 - every relative link in docs/ and README.md names a file that exists, and an anchor into a Markdown page names
   one of its headings;
@@ -77,6 +78,7 @@ class DocsSite(unittest.TestCase):
                 stem = page[:-3]
                 html = stem[:-5] + "index.html" if stem.endswith("index") else stem + "/index.html"
                 self.assertTrue((pathlib.Path(out) / html).is_file(), f"no {html} for {page}")
+                self.assertNotIn("|---|", (pathlib.Path(out) / html).read_text(), f"a table of {page} not rendered")
 
     def test_every_page_is_in_the_navigation(self):
         in_nav = set(nav_pages(self.config["nav"]))

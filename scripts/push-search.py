@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""push-search: the largest forward push each controller recovers from while stepping in place (docs/guide/closed-loop.md,
-"Push recovery"). For every actuator model, controller and height it runs
+"""push-search: the largest forward push each controller recovers from while stepping in place
+(docs/notebook/2026-11-24-closed-loop-push-recovery.md, "Push recovery"). For every actuator model, controller and height it runs
 
   mft-closedloop --config-dir <copy with actuators.model = M> --height H --controller C --duration 10
                  --push I --push-at 5 --recovery-rule R --json

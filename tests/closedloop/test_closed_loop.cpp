@@ -62,10 +62,10 @@ TEST_P(SteppingInPlace, HoldsItsPlaceWithoutFalling) {
   expectEstimatorTracksTruth(s);
   std::printf("%s at %.2f m: mean base height %.4f m, max MFT violation %.4f rad\n", c.controller, c.height,
               s.mean_base_z, s.max_mft_violation);
-  // Both variants track the command less the predicted sag (the 4 mm band covers the estimator's 2 mm height
-  // bias, docs/guide/closed-loop.md). Up to 0.44 m the sagged stance lies inside the MFT polytope (the hexagon holds
-  // the vertical stance up to 0.435 m, docs/guide/mft-space.md), so the MFT rows are inactive and MFT-WBC steps like
-  // SA-WBC; at 0.46 m it lies outside.
+  // Both variants track the command less the predicted sag (the 4 mm band covers the estimator's 2 mm height bias,
+  // docs/notebook/2026-11-29-closed-loop-history.md). Up to 0.44 m the sagged stance lies inside the MFT polytope
+  // (the hexagon holds the vertical stance up to 0.435 m, docs/guide/mft-space.md), so the MFT rows are inactive
+  // and MFT-WBC steps like SA-WBC; at 0.46 m it lies outside.
   const double expected = c.height - predictedSag(configs(), 1);
   if (std::string(c.controller) == "sa" || c.height < 0.45) {
     EXPECT_NEAR(s.mean_base_z, expected, 0.004);

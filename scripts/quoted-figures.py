@@ -10,7 +10,7 @@ A results page states a figure in one of two places only:
     are its JSON values and every number inside its strings and keys (JSON, JSON lines), or every number in its
     text (any other file: a command's captured output, a configuration). A figure may be printed in another unit
     than the file's: x100 (a fraction as a percentage), x1000 or /1000 (s and ms, ms and us), /60 (s as
-    minutes). Signs are ignored ("down to -0.5 rad" quotes -0.5).
+    minutes). Signs are ignored ("down to -0.5 rad" quotes -0.5). 1,376 and 60 000 are one figure each, and so is 10⁶.
 Not figures: numbers in `code` and code blocks, ordered lists' markers, link targets, headings, images and comments; dates, clock times, commits;
 "Table II", "Fig. 6", "eq. 13", "2-vCPU". Any other number outside those two places is reported as unquoted.
 
@@ -28,7 +28,9 @@ QUOTES = re.compile(r"<!-- quotes: ([^>]+?) -->\n(.*?)<!-- end quotes -->", re.S
 GENERATED = re.compile(r"<!-- generated: [^>]+? -->\n.*?<!-- end generated -->", re.S)
 FENCE = re.compile(r"^[ \t]*```.*?^[ \t]*```", re.S | re.M)
 LIST_MARKER = re.compile(r"^\s*\d+\.\s", re.M)
-NUMBER = re.compile(r"(?<![\w.])\d+(?:,\d{3})*(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w])")
+NUMBER = re.compile(r"(?<![\w.])(?:\d{1,3}(?:[ \u202f\u00a0]\d{3})+(?![\d,])|\d+(?:,\d{3})*)(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w])")
+SUPERSCRIPT_POWER = re.compile(r"\b10(⁻?[⁰¹²³⁴⁵⁶⁷⁸⁹]+)")
+SUPERSCRIPTS = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
 NOT_FIGURES = [
     re.compile(r"`[^`]*`"),                                  # code: commands, paths, options
     re.compile(r"\]\([^)]*\)"),                              # link targets
@@ -42,8 +44,18 @@ NOT_FIGURES = [
 SCALES = (1.0, 100.0, 1000.0, 1e-3, 1.0 / 60.0)
 
 
+def value(printed):
+    """The number PRINTED stands for: 1,376 and 60 000 are thousands-grouped."""
+    return float(re.sub(r"[, \u202f\u00a0]", "", printed).replace("−", "-"))
+
+
+def powers_of_ten(text):
+    """10⁶ written as 1e6, so that it reads as one figure."""
+    return SUPERSCRIPT_POWER.sub(lambda m: "1e" + m.group(1).translate(SUPERSCRIPTS), text)
+
+
 def numbers_in_text(text):
-    return [float(m.group(0).replace(",", "").replace("−", "-")) for m in NUMBER.finditer(text)]
+    return [value(m.group(0)) for m in NUMBER.finditer(powers_of_ten(text))]
 
 
 def numbers_in_json(value, out):
@@ -84,7 +96,7 @@ def prose(text):
     text = LIST_MARKER.sub(" ", text)
     for pattern in NOT_FIGURES:
         text = pattern.sub(" ", text)
-    return text
+    return powers_of_ten(text)
 
 
 def figures(text):
@@ -94,7 +106,7 @@ def figures(text):
         printed = m.group(0)
         mantissa = printed.split("e")[0]
         decimals = len(mantissa.split(".")[1]) if "." in mantissa else 0
-        out.append((printed, float(printed.replace(",", "").replace("−", "-")), decimals))
+        out.append((printed, value(printed), decimals))
     return out
 
 

@@ -71,14 +71,15 @@ class ResultsPages(unittest.TestCase):
     def test_the_figure_check_finds_a_misquote_and_an_unquoted_figure(self):
         with tempfile.TemporaryDirectory() as tmp:
             docs = pathlib.Path(tmp)
-            (docs / "data.json").write_text(json.dumps({"i_max_Ns": 12.66, "why": "fell at 6.473 s", "frac": 0.252}))
+            (docs / "data.json").write_text(json.dumps({"i_max_Ns": 12.66, "why": "fell at 6.473 s", "frac": 0.252,
+                                                        "ticks": 60000}))
             page = docs / "page.md"
             page.write_text("## Fig. 6 on 2026-11-28 at bcfa0af\n<!-- quotes: data.json -->\n"
-                            "Recovers up to 12.7 N s (`--start 12.0`), falls at 6.47 s, +25.2 %; 12.6 is wrong.\n"
-                            "<!-- end quotes -->\nLoose 3.3 here.\n")
+                            "Recovers up to 12.7 N s (`--start 12.0`), falls at 6.47 s, +25.2 %, 60 000 ticks; "
+                            "12.6 is wrong, and so is tick + 10⁶.\n<!-- end quotes -->\nLoose 3.3 here.\n")
             problems = self.quoted.check_page(page, docs)
         self.assertEqual([(kind, figure) for kind, _, figure in problems],
-                         [("not in its files", "12.6"), ("unquoted", "3.3")])
+                         [("not in its files", "12.6"), ("not in its files", "1e6"), ("unquoted", "3.3")])
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser()

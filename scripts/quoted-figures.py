@@ -11,7 +11,8 @@ A results page states a figure in one of two places only:
     text (any other file: a command's captured output, a configuration). A figure may be printed in another unit
     than the file's: x100 (a fraction as a percentage), x1000 or /1000 (s and ms, ms and us), /60 (s as
     minutes). Signs are ignored ("down to -0.5 rad" quotes -0.5). 1,376 and 60 000 are one figure each, and so is 10⁶.
-Not figures: numbers in `code` and code blocks, ordered lists' markers, link targets, headings, images and comments; dates, clock times, commits;
+Not figures: numbers in `code` and code blocks, ordered lists' markers, link targets, headings, images and
+comments; dates, clock times, commits;
 "Table II", "Fig. 6", "eq. 13", "2-vCPU". Any other number outside those two places is reported as unquoted.
 
 The default checks docs/results/*.md and exits 1 listing every figure not found and every unquoted one, as the
@@ -28,7 +29,8 @@ QUOTES = re.compile(r"<!-- quotes: ([^>]+?) -->\n(.*?)<!-- end quotes -->", re.S
 GENERATED = re.compile(r"<!-- generated: [^>]+? -->\n.*?<!-- end generated -->", re.S)
 FENCE = re.compile(r"^[ \t]*```.*?^[ \t]*```", re.S | re.M)
 LIST_MARKER = re.compile(r"^\s*\d+\.\s", re.M)
-NUMBER = re.compile(r"(?<![\w.])(?:\d{1,3}(?:[ \u202f\u00a0]\d{3})+(?![\d,])|\d+(?:,\d{3})*)(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w])")
+NUMBER = re.compile(r"(?<![\w.])(?:\d{1,3}(?:[ \u202f\u00a0]\d{3})+(?![\d,])|\d+(?:,\d{3})*)"  # 60 000, 1,376
+                    r"(?:\.\d+)?(?:e[+−-]?\d+)?(?![\w])")
 SUPERSCRIPT_POWER = re.compile(r"\b10(⁻?[⁰¹²³⁴⁵⁶⁷⁸⁹]+)")
 SUPERSCRIPTS = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
 NOT_FIGURES = [
@@ -86,7 +88,7 @@ def numbers_in_file(path):
                 numbers_in_json(json.loads(line), out)
     else:
         out = numbers_in_text(text)
-    return sorted({abs(v) for v in out})
+    return {abs(v) for v in out}
 
 
 def prose(text):
@@ -128,7 +130,7 @@ def check_page(page, docs, unquoted=True):
         if missing:
             problems.append(("missing file", m.group(1), " ".join(str(f) for f in missing)))
             continue
-        pool = sorted({v for f in files for v in numbers_in_file(f)})
+        pool = {v for f in files for v in numbers_in_file(f)}
         line = text[:m.start()].count("\n") + 1
         for printed, value, decimals in figures(m.group(2)):
             if not found(value, decimals, pool):
@@ -146,8 +148,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--docs", default=str(ROOT / "docs"), help="the docs folder (default: the repository's)")
     ap.add_argument("--page", nargs="+", action="extend", help="check these pages only (paths)")
-    ap.add_argument("--quoted-only", action="store_true",
-                    help="check the quoted passages only, not the figures outside them (a page that is not a results page)")
+    ap.add_argument("--quoted-only", action="store_true", help="check the quoted passages only, not the figures "
+                    "outside them (a page that is not a results page)")
     ap.add_argument("--json", action="store_true", help="print the problems as JSON")
     a = ap.parse_args()
     docs = Path(a.docs)

@@ -15,18 +15,28 @@ HEADER = ["| run | sensor → command p50 / p99 / p99.9 / max [µs] | timer late
           "|---|---|---|---|---|---|---|"]
 
 
+def chain_timer_p99(d):
+    """The timer lateness p99 of the chain's CPU in run D (of the worst CPU when the chain was not pinned)."""
+    late, cpu = d["machine_wakeup"]["timer_late_us"], d["realtime"].get("chain_cpu")
+    return late[f"cpu{cpu}"]["p99"] if cpu is not None else max(v["p99"] for v in late.values())
+
+
+def wbc_lockstep_p99(d):
+    """The WBC's compute p99 in run D's first lockstep round set (the realtime tick's reference)."""
+    lock = next(iter(d["lockstep"].values()))
+    return next(i for i in lock["hop_table"]["intervals"] if i["interval"] == "WBC compute")["p99"]
+
+
 def row(path):
     d = json.loads(Path(path).read_text())
     rt = d["realtime"]
     s, w = rt["sensor_to_command_latency_us"], rt["wbc_tick_us"]
-    lock = next(iter(d["lockstep"].values()))
-    wbc_lock = next(i for i in lock["hop_table"]["intervals"] if i["interval"] == "WBC compute")
-    late = d["machine_wakeup"]["timer_late_us"]
-    cpu = rt.get("chain_cpu")
-    mine = late[f"cpu{cpu}"]["p99"] if cpu is not None else max(v["p99"] for v in late.values())
+    late, cpu = d["machine_wakeup"]["timer_late_us"], rt.get("chain_cpu")
+    mine = chain_timer_p99(d)
     others = ", ".join(f"{v['p99']:.0f}" for k, v in sorted(late.items()) if cpu is None or k != f"cpu{cpu}")
     return (f"| {Path(path).stem} | {s['p50']:.0f} / {s['p99']:.0f} / {s.get('p99_9', float('nan')):.0f} / "
-            f"{s['max']:.0f} | {mine:.0f} ({others}) | {s['p99'] - mine:+.0f} | {w['p99']:.0f} / {wbc_lock['p99']:.0f} "
+            f"{s['max']:.0f} | {mine:.0f} ({others}) | {s['p99'] - mine:+.0f} | "
+            f"{w['p99']:.0f} / {wbc_lockstep_p99(d):.0f} "
             f"| {rt['sim_deadline_misses']} ({rt['sim_misses_unexplained']}) | "
             f"{d['load_average_before']['1min']:.2f} → {d['load_average_after']['1min']:.2f} |")
 
@@ -85,13 +95,9 @@ def target_figures(path):
     """(p99, p99 over the chain CPU's timer p99, WBC tick p99 realtime / lockstep, misses, misses outside a stall)."""
     d = json.loads(Path(path).read_text())
     rt = d["realtime"]
-    lock = next(iter(d["lockstep"].values()))
-    wbc_lock = next(i for i in lock["hop_table"]["intervals"] if i["interval"] == "WBC compute")["p99"]
-    late = d["machine_wakeup"]["timer_late_us"]
-    cpu = rt.get("chain_cpu")
-    timer = late[f"cpu{cpu}"]["p99"] if cpu is not None else max(v["p99"] for v in late.values())
     p99 = rt["sensor_to_command_latency_us"]["p99"]
-    return p99, p99 - timer, rt["wbc_tick_us"]["p99"] / wbc_lock, rt["sim_deadline_misses"], rt["sim_misses_unexplained"]
+    return (p99, p99 - chain_timer_p99(d), rt["wbc_tick_us"]["p99"] / wbc_lockstep_p99(d), rt["sim_deadline_misses"],
+            rt["sim_misses_unexplained"])
 
 
 def targets_table(paths):
@@ -100,10 +106,14 @@ def targets_table(paths):
     latency_met = [n for n, f in runs.items() if f[0] <= TARGET_P99_US or f[1] <= TARGET_P99_OVER_TIMER_US]
     wbc_met = [n for n, f in runs.items() if f[2] <= TARGET_WBC_TICK_RATIO]
     missed = [n for n in runs if n not in wbc_met]
-    span = lambda i, fmt: f"{fmt.format(min(f[i] for f in runs.values()))}–{fmt.format(max(f[i] for f in runs.values()))}"
+
+    def span(i, fmt):
+        values = [f[i] for f in runs.values()]
+        return f"{fmt.format(min(values))}–{fmt.format(max(values))}"
+
     return ["| target | runs that met it |", "|---|---|",
-            f"| sensor → command p99 at most {TARGET_P99_US:.0f} µs, or at most {TARGET_P99_OVER_TIMER_US:.0f} µs above "
-            f"the timer lateness p99 of the chain's CPU in the same run | {len(latency_met)} of {len(runs)} (p99 "
+            f"| sensor → command p99 at most {TARGET_P99_US:.0f} µs, or at most {TARGET_P99_OVER_TIMER_US:.0f} µs "
+            f"above the timer lateness p99 of the chain's CPU in the same run | {len(latency_met)} of {len(runs)} (p99 "
             f"{span(0, '{:.0f}')} µs; over the timer's {span(1, '{:+.0f}')} µs) |",
             f"| the WBC's tick p99 in realtime at most {TARGET_WBC_TICK_RATIO:g} times its lockstep p99 | "
             f"{len(wbc_met)} of {len(runs)} (ratio {span(2, '{:.2f}')}" + (f"; not met: {', '.join(missed)}" if missed
